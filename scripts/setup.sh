@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs the Debian packages this package needs (only when some are missing),
+# wraps the repository in a catkin workspace under build/ws and builds it in Release.
+# Sourced by run_demo.sh and run_tests.sh; safe to run again (incremental build).
+set -euo pipefail
+
+REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+WS="$REPO_ROOT/build/ws"
+PKG=breast_tumour_registration
+
+DEB_PACKAGES=(
+  ros-core-dev libtf2-ros-dev libtf2-eigen-dev libpcl-conversions-dev libpcl-dev
+  libcgal-dev libsuitesparse-dev libeigen3-dev python3-rostest librostest-dev
+  python3-rosbag librosbag-dev ros-message-generation libstd-srvs-dev python3-roslaunch
+  libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
+  python3-matplotlib python3-numpy cmake g++ make time
+)
+
+missing=()
+for p in "${DEB_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ "${#missing[@]}" -gt 0 ]; then
+  echo "[setup] installing ${#missing[@]} Debian packages: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "[setup] all Debian packages present"
+fi
+
+# catkin wants <ws>/src/<package>; the repository root is the package.
+mkdir -p "$WS/src"
+ln -sfn ../../.. "$WS/src/$PKG"
+
+# The pyenv python3 on PATH lacks catkin_pkg: always use Debian's interpreter.
+export PATH="/usr/bin:$PATH"
+JOBS="${BTR_JOBS:-$(nproc)}"
+cd "$WS"
+echo "[setup] building in $WS (Release, $JOBS jobs)"
+catkin_make -j"$JOBS" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
+  -DCATKIN_ENABLE_TESTING="${BTR_ENABLE_TESTING:-ON}" "$@"
