@@ -1,0 +1,30 @@
+// Readers and writers for surface meshes (OBJ, PLY, STL, OFF) and tetrahedral
+// meshes (legacy VTK unstructured grid, Medit .mesh). The length unit of the file
+// is applied here, once: everything returned is in metres.
+#pragma once
+
+#include <string>
+
+#include "breast_tumour_registration/core/types.h"
+#include "breast_tumour_registration/core/units.h"
+
+namespace btr {
+
+/// Reads a triangle surface; the format follows the extension (.obj .ply .stl .off).
+/// Polygons are fan-triangulated; STL's duplicated corners are merged.
+/// Throws InputError naming the file (and line, for text formats) on any problem.
+/// Only syntax and index range are checked here; see validation.h for geometry.
+SurfaceMesh read_surface(const std::string& path, LengthUnit unit);
+/// Writes a triangle surface; the format follows the extension (.obj .ply .stl .off).
+void write_surface(const std::string& path, const SurfaceMesh& mesh, LengthUnit unit);
+
+/// Reads a tetrahedral mesh from legacy VTK (.vtk, ASCII unstructured grid,
+/// cell type 10) or Medit (.mesh). Non-tetrahedral cells are an error.
+TetMesh read_tet_mesh(const std::string& path, LengthUnit unit);
+/// Writes legacy VTK (.vtk) or Medit (.mesh).
+void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit);
+
+/// Lower-case extension including the dot (".obj"); empty when there is none.
+std::string file_extension(const std::string& path);
+
+}  // namespace btr

@@ -1,0 +1,638 @@
+#include "breast_tumour_registration/core/mesh_io.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "breast_tumour_registration/core/errors.h"
+
+namespace btr {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+std::ifstream open_in(const std::string& path, bool binary = false) {
+  std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
+  if (!in) throw InputError("cannot open '" + path + "': file missing or unreadable");
+  return in;
+}
+
+std::ofstream open_out(const std::string& path, bool binary = false) {
+  std::ofstream out(path, binary ? std::ios::binary : std::ios::out);
+  if (!out) throw InputError("cannot write '" + path + "' (does the folder exist?)");
+  out.precision(17);
+  return out;
+}
+
+[[noreturn]] void fail(const std::string& path, size_t line, const std::string& what) {
+  throw InputError(path + ":" + std::to_string(line) + ": " + what);
+}
+
+double parse_double(const std::string& tok, const std::string& path, size_t line) {
+  try {
+    size_t used = 0;
+    double v = std::stod(tok, &used);
+    if (used != tok.size()) fail(path, line, "cannot parse number '" + tok + "'");
+    return v;
+  } catch (const std::logic_error&) {
+    // stod throws out_of_range for denormals on some libcs; treat as a parse error.
+    fail(path, line, "cannot parse number '" + tok + "'");
+  }
+}
+
+long parse_long(const std::string& tok, const std::string& path, size_t line) {
+  try {
+    size_t used = 0;
+    long v = std::stol(tok, &used);
+    if (used != tok.size()) fail(path, line, "cannot parse integer '" + tok + "'");
+    return v;
+  } catch (const std::logic_error&) {
+    fail(path, line, "cannot parse integer '" + tok + "'");
+  }
+}
+
+Points to_points(const std::vector<Vec3>& v, double scale) {
+  Points P(v.size(), 3);
+  for (size_t i = 0; i < v.size(); ++i) P.row(i) = v[i].transpose() * scale;
+  return P;
+}
+
+void check_indices(const std::string& path, const Eigen::MatrixXi& idx, long n, const char* what) {
+  for (Eigen::Index r = 0; r < idx.rows(); ++r)
+    for (Eigen::Index c = 0; c < idx.cols(); ++c)
+      if (idx(r, c) < 0 || idx(r, c) >= n)
+        throw InputError(path + ": " + what + " " + std::to_string(r) + " references vertex " +
+                         std::to_string(idx(r, c)) + " but the file has " + std::to_string(n) + " vertices");
+}
+
+void add_polygon(std::vector<Eigen::Vector3i>& tris, const std::vector<int>& poly, const std::string& path,
+                 size_t line) {
+  if (poly.size() < 3) fail(path, line, "face with fewer than 3 vertices");
+  for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
+}
+
+SurfaceMesh finish(const std::string& path, const std::vector<Vec3>& verts,
+                   const std::vector<Eigen::Vector3i>& tris, double scale) {
+  SurfaceMesh m;
+  m.V = to_points(verts, scale);
+  m.F.resize(tris.size(), 3);
+  for (size_t i = 0; i < tris.size(); ++i) m.F.row(i) = tris[i].transpose();
+  if (m.F.rows() == 0) throw InputError(path + ": no faces");
+  check_indices(path, m.F, m.V.rows(), "face");
+  return m;
+}
+
+// ---------------------------------------------------------------- OBJ
+SurfaceMesh read_obj(const std::string& path, double scale) {
+  auto in = open_in(path);
+  std::vector<Vec3> verts;
+  std::vector<Eigen::Vector3i> tris;
+  std::string line;
+  size_t ln = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    std::istringstream ss(line);
+    std::string tag;
+    if (!(ss >> tag) || tag[0] == '#') continue;
+    if (tag == "v") {
+      std::string a, b, c;
+      if (!(ss >> a >> b >> c)) fail(path, ln, "vertex needs 3 coordinates");
+      verts.emplace_back(parse_double(a, path, ln), parse_double(b, path, ln), parse_double(c, path, ln));
+    } else if (tag == "f") {
+      std::vector<int> poly;
+      std::string tok;
+      while (ss >> tok) {
+        const std::string head = tok.substr(0, tok.find('/'));
+        long idx = parse_long(head, path, ln);
+        if (idx < 0) idx = static_cast<long>(verts.size()) + idx + 1;  // OBJ relative index
+        if (idx < 1) fail(path, ln, "face index " + head + " out of range");
+        poly.push_back(static_cast<int>(idx - 1));
+      }
+      add_polygon(tris, poly, path, ln);
+    }
+  }
+  return finish(path, verts, tris, scale);
+}
+
+void write_obj(const std::string& path, const SurfaceMesh& m, double inv) {
+  auto out = open_out(path);
+  out << "# breast_tumour_registration\n";
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    out << "v " << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << '\n';
+  for (Eigen::Index i = 0; i < m.F.rows(); ++i)
+    out << "f " << m.F(i, 0) + 1 << ' ' << m.F(i, 1) + 1 << ' ' << m.F(i, 2) + 1 << '\n';
+}
+
+// ---------------------------------------------------------------- OFF
+SurfaceMesh read_off(const std::string& path, double scale) {
+  auto in = open_in(path);
+  // Tokenize ignoring comments, tracking line numbers.
+  std::vector<std::pair<std::string, size_t>> toks;
+  std::string line;
+  size_t ln = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    line = line.substr(0, line.find('#'));
+    std::istringstream ss(line);
+    std::string t;
+    while (ss >> t) toks.emplace_back(t, ln);
+  }
+  size_t k = 0;
+  auto next = [&](const char* what) -> const std::pair<std::string, size_t>& {
+    if (k >= toks.size()) fail(path, ln, std::string("unexpected end of file, expected ") + what);
+    return toks[k++];
+  };
+  if (toks.empty() || lower(toks[0].first).find("off") == std::string::npos)
+    throw InputError(path + ": missing OFF header");
+  ++k;
+  auto nv_t = next("vertex count");
+  auto nf_t = next("face count");
+  next("edge count");
+  const long nv = parse_long(nv_t.first, path, nv_t.second);
+  const long nf = parse_long(nf_t.first, path, nf_t.second);
+  if (nv < 0 || nf < 0) fail(path, nv_t.second, "negative element count");
+  std::vector<Vec3> verts;
+  verts.reserve(nv);
+  for (long i = 0; i < nv; ++i) {
+    Vec3 p;
+    for (int c = 0; c < 3; ++c) {
+      auto t = next("vertex coordinate");
+      p[c] = parse_double(t.first, path, t.second);
+    }
+    verts.push_back(p);
+  }
+  std::vector<Eigen::Vector3i> tris;
+  for (long i = 0; i < nf; ++i) {
+    auto t = next("face size");
+    const long n = parse_long(t.first, path, t.second);
+    std::vector<int> poly;
+    for (long j = 0; j < n; ++j) {
+      auto u = next("face index");
+      poly.push_back(static_cast<int>(parse_long(u.first, path, u.second)));
+    }
+    add_polygon(tris, poly, path, t.second);
+    // Skip optional per-face colour: tokens on the same line after the indices.
+    while (k < toks.size() && toks[k].second == t.second) ++k;
+  }
+  return finish(path, verts, tris, scale);
+}
+
+void write_off(const std::string& path, const SurfaceMesh& m, double inv) {
+  auto out = open_out(path);
+  out << "OFF\n" << m.V.rows() << ' ' << m.F.rows() << " 0\n";
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    out << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << '\n';
+  for (Eigen::Index i = 0; i < m.F.rows(); ++i)
+    out << "3 " << m.F(i, 0) << ' ' << m.F(i, 1) << ' ' << m.F(i, 2) << '\n';
+}
+
+// ---------------------------------------------------------------- STL
+// STL stores every triangle's corners; identical corners are merged into one vertex.
+struct VertexMerger {
+  std::map<std::array<double, 3>, int> index;
+  std::vector<Vec3> verts;
+  int add(const Vec3& p) {
+    auto [it, inserted] = index.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(verts.size()));
+    if (inserted) verts.push_back(p);
+    return it->second;
+  }
+};
+
+SurfaceMesh read_stl(const std::string& path, double scale) {
+  auto in = open_in(path, true);
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (content.size() < 15) throw InputError(path + ": file too short to be STL");
+  VertexMerger merge;
+  std::vector<Eigen::Vector3i> tris;
+  bool binary = true;
+  if (content.compare(0, 5, "solid") == 0) {
+    // "solid" may also start a binary header; binary size must then match exactly.
+    if (content.size() >= 84) {
+      uint32_t n = 0;
+      std::memcpy(&n, content.data() + 80, 4);
+      binary = (84 + 50ull * n == content.size());
+    } else {
+      binary = false;
+    }
+  }
+  if (binary) {
+    if (content.size() < 84) throw InputError(path + ": truncated binary STL header");
+    uint32_t n = 0;
+    std::memcpy(&n, content.data() + 80, 4);
+    if (84 + 50ull * n != content.size())
+      throw InputError(path + ": binary STL says " + std::to_string(n) + " triangles but the file size does not match");
+    for (uint32_t t = 0; t < n; ++t) {
+      const char* rec = content.data() + 84 + 50ull * t;
+      Eigen::Vector3i tri;
+      for (int c = 0; c < 3; ++c) {
+        float f[3];
+        std::memcpy(f, rec + 12 + 12 * c, 12);
+        tri[c] = merge.add(Vec3(f[0], f[1], f[2]));
+      }
+      tris.push_back(tri);
+    }
+  } else {
+    std::istringstream ss(content);
+    std::string line;
+    size_t ln = 0;
+    std::vector<int> corners;
+    while (std::getline(ss, line)) {
+      ++ln;
+      std::istringstream ls(line);
+      std::string tag;
+      if (!(ls >> tag)) continue;
+      tag = lower(tag);
+      if (tag == "vertex") {
+        std::string a, b, c;
+        if (!(ls >> a >> b >> c)) fail(path, ln, "vertex needs 3 coordinates");
+        corners.push_back(merge.add(Vec3(parse_double(a, path, ln), parse_double(b, path, ln),
+                                         parse_double(c, path, ln))));
+      } else if (tag == "endloop") {
+        if (corners.size() != 3) fail(path, ln, "facet with " + std::to_string(corners.size()) + " vertices");
+        tris.emplace_back(corners[0], corners[1], corners[2]);
+        corners.clear();
+      }
+    }
+  }
+  return finish(path, merge.verts, tris, scale);
+}
+
+void write_stl(const std::string& path, const SurfaceMesh& m, double inv) {
+  auto out = open_out(path, true);
+  char header[80] = {0};
+  std::snprintf(header, sizeof(header), "breast_tumour_registration binary STL");
+  out.write(header, 80);
+  const uint32_t n = static_cast<uint32_t>(m.F.rows());
+  out.write(reinterpret_cast<const char*>(&n), 4);
+  for (Eigen::Index i = 0; i < m.F.rows(); ++i) {
+    const Vec3 a = m.V.row(m.F(i, 0)), b = m.V.row(m.F(i, 1)), c = m.V.row(m.F(i, 2));
+    Vec3 nrm = (b - a).cross(c - a);
+    if (nrm.norm() > 0) nrm.normalize();
+    float rec[12];
+    for (int k = 0; k < 3; ++k) rec[k] = static_cast<float>(nrm[k]);
+    for (int v = 0; v < 3; ++v)
+      for (int k = 0; k < 3; ++k) rec[3 + 3 * v + k] = static_cast<float>(m.V(m.F(i, v), k) * inv);
+    out.write(reinterpret_cast<const char*>(rec), 48);
+    const uint16_t attr = 0;
+    out.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+}
+
+// ---------------------------------------------------------------- PLY
+struct PlyProperty {
+  std::string type;       // scalar type, or list value type
+  std::string count_type; // list count type; empty for scalars
+  std::string name;
+};
+struct PlyElement {
+  std::string name;
+  long count = 0;
+  std::vector<PlyProperty> props;
+};
+
+size_t ply_type_size(const std::string& t) {
+  if (t == "char" || t == "int8" || t == "uchar" || t == "uint8") return 1;
+  if (t == "short" || t == "int16" || t == "ushort" || t == "uint16") return 2;
+  if (t == "int" || t == "int32" || t == "uint" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+double ply_read_binary(const char*& p, const char* end, const std::string& t, const std::string& path) {
+  const size_t sz = ply_type_size(t);
+  if (sz == 0) throw InputError(path + ": unknown PLY type '" + t + "'");
+  if (p + sz > end) throw InputError(path + ": binary PLY truncated");
+  double v = 0;
+  if (t == "char" || t == "int8") { int8_t x; std::memcpy(&x, p, 1); v = x; }
+  else if (t == "uchar" || t == "uint8") { uint8_t x; std::memcpy(&x, p, 1); v = x; }
+  else if (t == "short" || t == "int16") { int16_t x; std::memcpy(&x, p, 2); v = x; }
+  else if (t == "ushort" || t == "uint16") { uint16_t x; std::memcpy(&x, p, 2); v = x; }
+  else if (t == "int" || t == "int32") { int32_t x; std::memcpy(&x, p, 4); v = x; }
+  else if (t == "uint" || t == "uint32") { uint32_t x; std::memcpy(&x, p, 4); v = x; }
+  else if (t == "float" || t == "float32") { float x; std::memcpy(&x, p, 4); v = x; }
+  else { double x; std::memcpy(&x, p, 8); v = x; }
+  p += sz;
+  return v;
+}
+
+SurfaceMesh read_ply(const std::string& path, double scale) {
+  auto in = open_in(path, true);
+  std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t hdr_end = content.find("end_header");
+  if (content.compare(0, 3, "ply") != 0 || hdr_end == std::string::npos)
+    throw InputError(path + ": not a PLY file (missing 'ply' or 'end_header')");
+  std::istringstream hs(content.substr(0, hdr_end));
+  std::string line, format;
+  std::vector<PlyElement> elems;
+  while (std::getline(hs, line)) {
+    std::istringstream ls(line);
+    std::string tag;
+    ls >> tag;
+    if (tag == "format") ls >> format;
+    else if (tag == "element") { PlyElement e; ls >> e.name >> e.count; elems.push_back(e); }
+    else if (tag == "property") {
+      if (elems.empty()) throw InputError(path + ": PLY property before any element");
+      PlyProperty pr;
+      std::string t;
+      ls >> t;
+      if (t == "list") ls >> pr.count_type >> pr.type >> pr.name;
+      else { pr.type = t; ls >> pr.name; }
+      elems.back().props.push_back(pr);
+    }
+  }
+  size_t body = content.find('\n', hdr_end);
+  if (body == std::string::npos) throw InputError(path + ": PLY has no data after header");
+  ++body;
+  if (format != "ascii" && format != "binary_little_endian")
+    throw InputError(path + ": PLY format '" + format + "' not supported (ascii or binary_little_endian)");
+  const bool ascii = format == "ascii";
+  std::istringstream as(ascii ? content.substr(body) : std::string());
+  const char* p = content.data() + body;
+  const char* end = content.data() + content.size();
+  auto read_value = [&](const std::string& t) -> double {
+    if (!ascii) return ply_read_binary(p, end, t, path);
+    std::string tok;
+    if (!(as >> tok)) throw InputError(path + ": PLY data ends early");
+    return parse_double(tok, path, 0);
+  };
+  std::vector<Vec3> verts;
+  std::vector<Eigen::Vector3i> tris;
+  for (const auto& e : elems) {
+    for (long i = 0; i < e.count; ++i) {
+      Vec3 v = Vec3::Zero();
+      std::vector<int> poly;
+      for (const auto& pr : e.props) {
+        if (!pr.count_type.empty()) {
+          const long n = static_cast<long>(read_value(pr.count_type));
+          std::vector<int> vals;
+          for (long j = 0; j < n; ++j) vals.push_back(static_cast<int>(read_value(pr.type)));
+          if (e.name == "face" && (pr.name == "vertex_indices" || pr.name == "vertex_index")) poly = vals;
+        } else {
+          const double x = read_value(pr.type);
+          if (e.name == "vertex") {
+            if (pr.name == "x") v.x() = x;
+            else if (pr.name == "y") v.y() = x;
+            else if (pr.name == "z") v.z() = x;
+          }
+        }
+      }
+      if (e.name == "vertex") verts.push_back(v);
+      if (e.name == "face") add_polygon(tris, poly, path, 0);
+    }
+  }
+  return finish(path, verts, tris, scale);
+}
+
+void write_ply(const std::string& path, const SurfaceMesh& m, double inv) {
+  auto out = open_out(path);
+  out << "ply\nformat ascii 1.0\ncomment breast_tumour_registration\nelement vertex " << m.V.rows()
+      << "\nproperty double x\nproperty double y\nproperty double z\nelement face " << m.F.rows()
+      << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    out << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << '\n';
+  for (Eigen::Index i = 0; i < m.F.rows(); ++i)
+    out << "3 " << m.F(i, 0) << ' ' << m.F(i, 1) << ' ' << m.F(i, 2) << '\n';
+}
+
+// ---------------------------------------------------------------- VTK (legacy)
+TetMesh read_vtk(const std::string& path, double scale) {
+  auto in = open_in(path);
+  std::vector<std::pair<std::string, size_t>> toks;
+  std::string line;
+  size_t ln = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    if (ln == 1 && line.rfind("# vtk", 0) != 0) throw InputError(path + ":1: missing '# vtk DataFile' header");
+    if (ln == 2) continue;  // free-form title
+    std::istringstream ss(line);
+    std::string t;
+    while (ss >> t) toks.emplace_back(t, ln);
+  }
+  size_t k = 0;
+  auto next = [&](const char* what) -> const std::pair<std::string, size_t>& {
+    if (k >= toks.size()) fail(path, ln, std::string("unexpected end of file, expected ") + what);
+    return toks[k++];
+  };
+  std::vector<Vec3> verts;
+  std::vector<std::vector<int>> cells;
+  std::vector<int> types;
+  bool have_points = false, have_cells = false;
+  while (k < toks.size()) {
+    const auto tok = next("keyword");
+    const std::string kw = lower(tok.first);
+    if (kw == "ascii" || kw == "dataset") {
+      if (kw == "dataset") {
+        auto t = next("dataset type");
+        if (lower(t.first) != "unstructured_grid")
+          fail(path, t.second, "dataset '" + t.first + "' is not UNSTRUCTURED_GRID");
+      }
+    } else if (kw == "binary") {
+      fail(path, tok.second, "binary legacy VTK is not supported; save as ASCII");
+    } else if (kw == "points") {
+      const long n = parse_long(next("point count").first, path, tok.second);
+      next("point type");
+      verts.resize(n);
+      for (long i = 0; i < n; ++i)
+        for (int c = 0; c < 3; ++c) {
+          auto t = next("coordinate");
+          verts[i][c] = parse_double(t.first, path, t.second);
+        }
+      have_points = true;
+    } else if (kw == "cells") {
+      const long n = parse_long(next("cell count").first, path, tok.second);
+      next("cell list size");
+      cells.resize(n);
+      for (long i = 0; i < n; ++i) {
+        auto t = next("cell size");
+        const long m = parse_long(t.first, path, t.second);
+        for (long j = 0; j < m; ++j) {
+          auto u = next("cell index");
+          cells[i].push_back(static_cast<int>(parse_long(u.first, path, u.second)));
+        }
+      }
+      have_cells = true;
+    } else if (kw == "cell_types") {
+      const long n = parse_long(next("cell type count").first, path, tok.second);
+      for (long i = 0; i < n; ++i) {
+        auto t = next("cell type");
+        types.push_back(static_cast<int>(parse_long(t.first, path, t.second)));
+      }
+    } else if (kw == "point_data" || kw == "cell_data") {
+      break;  // attributes are not needed
+    }
+  }
+  if (!have_points || !have_cells) throw InputError(path + ": missing POINTS or CELLS section");
+  if (!types.empty() && types.size() != cells.size())
+    throw InputError(path + ": CELL_TYPES count differs from CELLS count");
+  TetMesh m;
+  m.V = to_points(verts, scale);
+  std::vector<Eigen::Vector4i> tets;
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const int type = types.empty() ? (cells[i].size() == 4 ? 10 : -1) : types[i];
+    if (type == 1 || type == 3 || type == 5) continue;  // vertices, lines, triangles (e.g. boundary) are skipped
+    if (type != 10 || cells[i].size() != 4)
+      throw InputError(path + ": cell " + std::to_string(i) + " has VTK type " + std::to_string(type) +
+                       " (only tetrahedra, type 10, are supported)");
+    tets.emplace_back(cells[i][0], cells[i][1], cells[i][2], cells[i][3]);
+  }
+  m.T.resize(tets.size(), 4);
+  for (size_t i = 0; i < tets.size(); ++i) m.T.row(i) = tets[i].transpose();
+  if (m.T.rows() == 0) throw InputError(path + ": no tetrahedra");
+  check_indices(path, m.T, m.V.rows(), "tetrahedron");
+  return m;
+}
+
+void write_vtk(const std::string& path, const TetMesh& m, double inv) {
+  auto out = open_out(path);
+  out << "# vtk DataFile Version 3.0\nbreast_tumour_registration tetrahedral mesh\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "POINTS " << m.V.rows() << " double\n";
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    out << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << '\n';
+  out << "CELLS " << m.T.rows() << ' ' << 5 * m.T.rows() << '\n';
+  for (Eigen::Index i = 0; i < m.T.rows(); ++i)
+    out << "4 " << m.T(i, 0) << ' ' << m.T(i, 1) << ' ' << m.T(i, 2) << ' ' << m.T(i, 3) << '\n';
+  out << "CELL_TYPES " << m.T.rows() << '\n';
+  for (Eigen::Index i = 0; i < m.T.rows(); ++i) out << "10\n";
+}
+
+// ---------------------------------------------------------------- Medit
+TetMesh read_medit(const std::string& path, double scale) {
+  auto in = open_in(path);
+  std::vector<std::pair<std::string, size_t>> toks;
+  std::string line;
+  size_t ln = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    line = line.substr(0, line.find('#'));
+    std::istringstream ss(line);
+    std::string t;
+    while (ss >> t) toks.emplace_back(t, ln);
+  }
+  size_t k = 0;
+  auto next = [&](const char* what) -> const std::pair<std::string, size_t>& {
+    if (k >= toks.size()) fail(path, ln, std::string("unexpected end of file, expected ") + what);
+    return toks[k++];
+  };
+  auto skip_block = [&](int per_item) {
+    const long n = parse_long(next("count").first, path, ln);
+    for (long i = 0; i < n * per_item; ++i) next("value");
+  };
+  std::vector<Vec3> verts;
+  std::vector<Eigen::Vector4i> tets;
+  bool have_v = false;
+  while (k < toks.size()) {
+    const auto tok = next("keyword");
+    const std::string kw = lower(tok.first);
+    if (kw == "meshversionformatted" || kw == "dimension") {
+      auto t = next("value");
+      if (kw == "dimension" && t.first != "3") fail(path, t.second, "only Dimension 3 is supported");
+    } else if (kw == "vertices") {
+      const long n = parse_long(next("vertex count").first, path, tok.second);
+      verts.resize(n);
+      for (long i = 0; i < n; ++i) {
+        for (int c = 0; c < 3; ++c) {
+          auto t = next("coordinate");
+          verts[i][c] = parse_double(t.first, path, t.second);
+        }
+        next("vertex reference");
+      }
+      have_v = true;
+    } else if (kw == "tetrahedra") {
+      const long n = parse_long(next("tetrahedron count").first, path, tok.second);
+      for (long i = 0; i < n; ++i) {
+        Eigen::Vector4i t;
+        for (int c = 0; c < 4; ++c) {
+          auto u = next("tetrahedron index");
+          t[c] = static_cast<int>(parse_long(u.first, path, u.second)) - 1;  // Medit is 1-based
+        }
+        next("tetrahedron reference");
+        tets.push_back(t);
+      }
+    } else if (kw == "triangles") {
+      skip_block(4);
+    } else if (kw == "edges") {
+      skip_block(3);
+    } else if (kw == "corners" || kw == "requiredvertices" || kw == "ridges" || kw == "requirededges") {
+      skip_block(1);
+    } else if (kw == "end") {
+      break;
+    } else {
+      fail(path, tok.second, "unknown Medit keyword '" + tok.first + "'");
+    }
+  }
+  if (!have_v || tets.empty()) throw InputError(path + ": missing Vertices or Tetrahedra section");
+  TetMesh m;
+  m.V = to_points(verts, scale);
+  m.T.resize(tets.size(), 4);
+  for (size_t i = 0; i < tets.size(); ++i) m.T.row(i) = tets[i].transpose();
+  check_indices(path, m.T, m.V.rows(), "tetrahedron");
+  return m;
+}
+
+void write_medit(const std::string& path, const TetMesh& m, double inv) {
+  auto out = open_out(path);
+  out << "MeshVersionFormatted 2\nDimension 3\nVertices\n" << m.V.rows() << '\n';
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    out << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << " 0\n";
+  out << "Tetrahedra\n" << m.T.rows() << '\n';
+  for (Eigen::Index i = 0; i < m.T.rows(); ++i)
+    out << m.T(i, 0) + 1 << ' ' << m.T(i, 1) + 1 << ' ' << m.T(i, 2) + 1 << ' ' << m.T(i, 3) + 1 << " 1\n";
+  out << "End\n";
+}
+
+}  // namespace
+
+std::string file_extension(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  return lower(path.substr(dot));
+}
+
+SurfaceMesh read_surface(const std::string& path, LengthUnit unit) {
+  const std::string ext = file_extension(path);
+  const double s = metres_per_unit(unit);
+  if (ext == ".obj") return read_obj(path, s);
+  if (ext == ".off") return read_off(path, s);
+  if (ext == ".stl") return read_stl(path, s);
+  if (ext == ".ply") return read_ply(path, s);
+  throw InputError("'" + path + "': unknown surface format '" + ext + "' (expected .obj, .ply, .stl or .off)");
+}
+
+void write_surface(const std::string& path, const SurfaceMesh& mesh, LengthUnit unit) {
+  const std::string ext = file_extension(path);
+  const double inv = 1.0 / metres_per_unit(unit);
+  if (ext == ".obj") return write_obj(path, mesh, inv);
+  if (ext == ".off") return write_off(path, mesh, inv);
+  if (ext == ".stl") return write_stl(path, mesh, inv);
+  if (ext == ".ply") return write_ply(path, mesh, inv);
+  throw InputError("'" + path + "': unknown surface format '" + ext + "' (expected .obj, .ply, .stl or .off)");
+}
+
+TetMesh read_tet_mesh(const std::string& path, LengthUnit unit) {
+  const std::string ext = file_extension(path);
+  const double s = metres_per_unit(unit);
+  if (ext == ".vtk") return read_vtk(path, s);
+  if (ext == ".mesh") return read_medit(path, s);
+  throw InputError("'" + path + "': unknown tetrahedral mesh format '" + ext + "' (expected .vtk or .mesh)");
+}
+
+void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit) {
+  const std::string ext = file_extension(path);
+  const double inv = 1.0 / metres_per_unit(unit);
+  if (ext == ".vtk") return write_vtk(path, mesh, inv);
+  if (ext == ".mesh") return write_medit(path, mesh, inv);
+  throw InputError("'" + path + "': unknown tetrahedral mesh format '" + ext + "' (expected .vtk or .mesh)");
+}
+
+}  // namespace btr

@@ -1,0 +1,45 @@
+// Helpers shared by the core tests.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include "breast_tumour_registration/core/types.h"
+
+namespace btr::test {
+
+/// A fresh temporary folder per test.
+inline std::string temp_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  auto dir = std::filesystem::temp_directory_path() / "btr_tests" /
+             (std::string(info->test_suite_name()) + "_" + info->name());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+inline void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+/// Runs f and expects it to throw E whose message contains `needle`.
+template <class E, class F>
+void expect_throw_with(F&& f, const std::string& needle) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an exception containing '" << needle << "'";
+  } catch (const E& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message was: " << e.what();
+  }
+}
+
+inline Mat3 random_matrix(std::mt19937& rng, double scale = 1.0) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Mat3 m;
+  for (int i = 0; i < 9; ++i) m(i) = scale * u(rng);
+  return m;
+}
+
+}  // namespace btr::test
