@@ -1,0 +1,44 @@
+// One term of the quasi-static energy E(x) (thesis Sec. 3.2). Each term gives its value,
+// adds its gradient to a full 3#V vector, and adds its Hessian (optionally projected to
+// be positive semi-definite) into the shared sparse assembler.
+#pragma once
+
+#include <string>
+
+#include "breast_tumour_registration/core/hessian_pattern.h"
+#include "breast_tumour_registration/core/types.h"
+
+namespace btr {
+
+class EnergyTerm {
+ public:
+  virtual ~EnergyTerm() = default;
+  virtual std::string name() const = 0;
+  /// x  #V by 3 current positions [m]; returns joules.
+  virtual double value(const Points& x) const = 0;
+  /// Adds dE/dx to g (3#V, layout [x0 y0 z0 x1 ...]).
+  virtual void add_gradient(const Points& x, Eigen::VectorXd& g) const = 0;
+  /// Adds d2E/dx2 into H; with project_psd, each local block is made PSD first.
+  virtual void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const = 0;
+};
+
+/// A point carried by up to four mesh vertices: p(x) = sum_k w_k x_{v_k}
+/// (a vertex, a barycentric point on a boundary triangle, or one inside a tetrahedron).
+struct Anchor {
+  int count = 1;
+  int v[4] = {0, 0, 0, 0};
+  double w[4] = {1, 0, 0, 0};
+
+  static Anchor vertex(int i) {
+    Anchor a;
+    a.v[0] = i;
+    return a;
+  }
+  Vec3 position(const Points& x) const {
+    Vec3 p = Vec3::Zero();
+    for (int k = 0; k < count; ++k) p += w[k] * x.row(v[k]).transpose();
+    return p;
+  }
+};
+
+}  // namespace btr

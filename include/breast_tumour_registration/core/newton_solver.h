@@ -1,0 +1,90 @@
+// Quasi-static Newton solver (thesis Sec. 3.2): minimizes a TotalEnergy over the free
+// vertices with a PSD-projected Hessian, CHOLMOD supernodal Cholesky (symbolic analysis
+// once per solver, numeric factorization per iteration) and a backtracking line search.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/core/hessian_pattern.h"
+#include "breast_tumour_registration/core/total_energy.h"
+
+namespace btr {
+
+enum class StopReason {
+  GradientTolerance,  ///< |g| <= abs_tol + rel_tol max(|g0|, force_scale)   (converged)
+  StepTolerance,      ///< max vertex displacement of a full step below step_tolerance (converged)
+  MaxIterations,      ///< iteration cap reached
+  LineSearchFailed,   ///< no step decreased the energy; state is the best found
+  Aborted,            ///< the callback asked to stop
+};
+std::string to_string(StopReason r);
+
+struct IterationInfo {
+  int iteration = 0;
+  double energy = 0;         ///< after the step [J]
+  double gradient_norm = 0;  ///< free-DOF gradient 2-norm after the step [N]
+  double alpha = 0;          ///< accepted step length
+  double step_norm = 0;      ///< max vertex displacement of the accepted step [m]
+  long inverted = 0;         ///< inverted tetrahedra after the step
+  double elapsed = 0;        ///< seconds since the solve started
+  double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< this iteration [s]
+};
+
+struct NewtonOptions {
+  int max_iterations = 100;
+  double gradient_rel_tolerance = 1e-6;  ///< relative to max(initial gradient norm, force_scale)
+  /// A physical force scale [N] (e.g. the body's weight) so that a warm start from a
+  /// near-solution is judged against the problem's forces, not its own tiny residual.
+  double force_scale = 0;
+  double gradient_abs_tolerance = 1e-10; ///< [N]
+  double step_tolerance = 1e-9;          ///< [m], on the full Newton step
+  int max_line_search_steps = 40;
+  double armijo = 1e-4;
+  bool project_psd = true;
+  /// Reject line-search steps that invert more tetrahedra than the current state has.
+  bool forbid_new_inversions = true;
+  /// Called after every accepted iteration; return false to abort.
+  std::function<bool(const IterationInfo&)> callback;
+};
+
+struct NewtonResult {
+  StopReason reason = StopReason::MaxIterations;
+  bool converged = false;
+  int iterations = 0;
+  double initial_energy = 0, energy = 0;
+  double initial_gradient_norm = 0, gradient_norm = 0;
+  long inverted = 0;
+  double seconds = 0;
+  double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< totals [s]
+  int regularizations = 0;  ///< factorizations that needed a diagonal shift
+  std::vector<IterationInfo> history;
+};
+
+/// Newton solver bound to one sparsity pattern: the CHOLMOD symbolic analysis is done on
+/// the first solve and reused by every later solve with the same assembler.
+class NewtonSolver {
+ public:
+  /// tets are used only to count inversions for the line search (may be empty).
+  NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets);
+  ~NewtonSolver();
+  NewtonSolver(const NewtonSolver&) = delete;
+  NewtonSolver& operator=(const NewtonSolver&) = delete;
+
+  /// Minimizes energy over the free vertices of x in place; fixed vertices keep their
+  /// positions. Throws SolverError if the energy is not finite at the start or the
+  /// Hessian cannot be factorized even after regularization.
+  NewtonResult solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt);
+
+  HessianAssembler& assembler() { return *assembler_; }
+
+ private:
+  struct Impl;
+  std::shared_ptr<HessianAssembler> assembler_;
+  Tetrahedra tets_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace btr

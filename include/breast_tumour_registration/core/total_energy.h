@@ -1,0 +1,26 @@
+// The sum of energy terms minimized by the Newton solver.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "breast_tumour_registration/core/energy_term.h"
+
+namespace btr {
+
+class TotalEnergy {
+ public:
+  void add(std::shared_ptr<const EnergyTerm> term) { terms_.push_back(std::move(term)); }
+  const std::vector<std::shared_ptr<const EnergyTerm>>& terms() const { return terms_; }
+
+  double value(const Points& x) const;
+  /// Full 3#V gradient.
+  Eigen::VectorXd gradient(const Points& x) const;
+  /// Zeroes H and assembles every term into it.
+  void hessian(const Points& x, bool project_psd, HessianAssembler& H) const;
+
+ private:
+  std::vector<std::shared_ptr<const EnergyTerm>> terms_;
+};
+
+}  // namespace btr

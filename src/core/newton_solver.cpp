@@ -1,0 +1,175 @@
+#include "breast_tumour_registration/core/newton_solver.h"
+
+#include <Eigen/CholmodSupport>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/tet_kinematics.h"
+
+namespace btr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+std::string to_string(StopReason r) {
+  switch (r) {
+    case StopReason::GradientTolerance: return "gradient tolerance reached";
+    case StopReason::StepTolerance: return "step tolerance reached";
+    case StopReason::MaxIterations: return "maximum iterations reached";
+    case StopReason::LineSearchFailed: return "line search found no decrease";
+    case StopReason::Aborted: return "aborted by callback";
+  }
+  return "unknown";
+}
+
+struct NewtonSolver::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  bool analyzed = false;
+};
+
+NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
+    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {}
+
+NewtonSolver::~NewtonSolver() = default;
+
+NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
+  const auto t_start = Clock::now();
+  HessianAssembler& H = *assembler_;
+  NewtonResult res;
+  auto inverted = [&](const Points& p) { return tets_.rows() ? count_inverted(p, tets_) : 0L; };
+
+  double E = energy.value(x);
+  if (!std::isfinite(E)) throw SolverError("energy is not finite at the initial state (NaN or Inf positions?)");
+  Eigen::VectorXd g = H.gather(energy.gradient(x));
+  long n_inv = inverted(x);
+  res.initial_energy = res.energy = E;
+  res.initial_gradient_norm = res.gradient_norm = g.norm();
+  res.inverted = n_inv;
+  const double g_tol = opt.gradient_abs_tolerance +
+                       opt.gradient_rel_tolerance * std::max(res.initial_gradient_norm, opt.force_scale);
+  if (H.num_free_dofs() == 0 || res.gradient_norm <= opt.gradient_abs_tolerance ||
+      (opt.force_scale > 0 && res.gradient_norm <= g_tol)) {
+    res.reason = StopReason::GradientTolerance;
+    res.converged = true;
+    res.seconds = since(t_start);
+    return res;
+  }
+
+  Points x_trial(x.rows(), 3);
+  for (int it = 1; it <= opt.max_iterations; ++it) {
+    IterationInfo info;
+    info.iteration = it;
+
+    auto t0 = Clock::now();
+    energy.hessian(x, opt.project_psd, H);
+    info.t_assembly = since(t0);
+
+    t0 = Clock::now();
+    auto& llt = impl_->llt;
+    if (!impl_->analyzed) {
+      llt.analyzePattern(H.matrix());
+      impl_->analyzed = true;
+    }
+    // The projected Hessian is PSD; with few constraints it can be singular, so a
+    // growing diagonal shift is tried before giving up.
+    double shift = 0;
+    const double diag_scale = H.matrix().diagonal().cwiseAbs().maxCoeff();
+    llt.setShift(0);
+    llt.factorize(H.matrix());
+    while (llt.info() != Eigen::Success) {
+      shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
+      if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30))
+        throw SolverError("Hessian could not be factorized even with a diagonal shift (non-finite entries?)");
+      llt.setShift(shift);
+      llt.factorize(H.matrix());
+      ++res.regularizations;
+    }
+    info.t_factorization = since(t0);
+
+    t0 = Clock::now();
+    Eigen::VectorXd d = -llt.solve(g);
+    info.t_solve = since(t0);
+    if (!d.allFinite()) throw SolverError("Newton direction is not finite");
+
+    // Full step as vertex displacements.
+    Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
+    H.scatter_add(d, 1.0, dx_full);
+    const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
+    const double full_step = dx.rowwise().norm().maxCoeff();
+    if (full_step <= opt.step_tolerance) {
+      res.reason = StopReason::StepTolerance;
+      res.converged = true;
+      break;
+    }
+
+    t0 = Clock::now();
+    const double slope = g.dot(d);  // < 0 for a descent direction
+    double alpha = 1.0;
+    bool accepted = false;
+    double E_new = E;
+    long inv_new = n_inv;
+    for (int ls = 0; ls < opt.max_line_search_steps; ++ls, alpha *= 0.5) {
+      x_trial = x + alpha * dx;
+      E_new = energy.value(x_trial);
+      if (!std::isfinite(E_new) || E_new > E + opt.armijo * alpha * std::min(slope, 0.0)) continue;
+      if (opt.forbid_new_inversions) {
+        inv_new = inverted(x_trial);
+        if (inv_new > n_inv) continue;
+      }
+      accepted = true;
+      break;
+    }
+    info.t_line_search = since(t0);
+    res.t_assembly += info.t_assembly;
+    res.t_factorization += info.t_factorization;
+    res.t_solve += info.t_solve;
+    res.t_line_search += info.t_line_search;
+    if (!accepted) {
+      res.reason = StopReason::LineSearchFailed;
+      break;
+    }
+    x.swap(x_trial);
+    E = E_new;
+    if (!opt.forbid_new_inversions) inv_new = inverted(x);
+    n_inv = inv_new;
+    g = H.gather(energy.gradient(x));
+
+    info.energy = E;
+    info.gradient_norm = g.norm();
+    info.alpha = alpha;
+    info.step_norm = alpha * full_step;
+    info.inverted = n_inv;
+    info.elapsed = since(t_start);
+    res.iterations = it;
+    res.energy = E;
+    res.gradient_norm = info.gradient_norm;
+    res.inverted = n_inv;
+    res.history.push_back(info);
+    if (opt.callback && !opt.callback(info)) {
+      res.reason = StopReason::Aborted;
+      break;
+    }
+    if (info.gradient_norm <= g_tol) {
+      res.reason = StopReason::GradientTolerance;
+      res.converged = true;
+      break;
+    }
+    if (info.step_norm <= opt.step_tolerance) {
+      res.reason = StopReason::StepTolerance;
+      res.converged = true;
+      break;
+    }
+  }
+  res.energy = E;
+  res.gradient_norm = g.norm();
+  res.inverted = n_inv;
+  res.seconds = since(t_start);
+  return res;
+}
+
+}  // namespace btr

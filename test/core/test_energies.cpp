@@ -1,0 +1,168 @@
+#include <Eigen/Eigenvalues>
+#include <memory>
+#include <random>
+
+#include "breast_tumour_registration/core/box_mesh.h"
+#include "breast_tumour_registration/core/elastic_energy.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_energy.h"
+#include "breast_tumour_registration/core/plane_constraint_energy.h"
+#include "breast_tumour_registration/core/point_constraint_energy.h"
+#include "breast_tumour_registration/core/total_energy.h"
+#include "test_util.h"
+
+using namespace btr;
+
+namespace {
+
+TetMesh small_mesh() { return make_box_tet_mesh(3, 2, 2, Vec3(0.06, 0.04, 0.04)); }
+
+Points perturbed(const TetMesh& m, double amount, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, amount);
+  Points x = m.V;
+  for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] += n(rng);
+  return x;
+}
+
+Anchor triangle_anchor(int a, int b, int c) {
+  Anchor an;
+  an.count = 3;
+  an.v[0] = a; an.v[1] = b; an.v[2] = c;
+  an.w[0] = 0.2; an.w[1] = 0.5; an.w[2] = 0.3;
+  return an;
+}
+
+// Checks a term's gradient (against central differences of the value) and Hessian
+// (against central differences of the gradient, column by column) at x, with shrinking steps.
+void check_term(const EnergyTerm& term, const TetMesh& mesh, const Points& x) {
+  const int nv = static_cast<int>(x.rows());
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  term.add_gradient(x, g);
+  HessianAssembler H(nv, mesh.T, {});
+  term.add_hessian(x, false, H);
+  const Eigen::MatrixXd Hd = Eigen::MatrixXd(H.matrix());
+  ASSERT_LT((Hd - Hd.transpose()).norm(), 1e-9 * std::max(1.0, Hd.norm())) << term.name() << ": Hessian not symmetric";
+
+  double best_g = 1e300, best_h = 1e300;
+  for (double h = 1e-4; h >= 1e-8; h *= 0.1) {
+    Eigen::VectorXd gn(x.size());
+    Eigen::MatrixXd Hn(x.size(), x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) {
+      Points xp = x, xm = x;
+      xp.data()[i] += h;
+      xm.data()[i] -= h;
+      gn[i] = (term.value(xp) - term.value(xm)) / (2 * h);
+      Eigen::VectorXd gp = Eigen::VectorXd::Zero(x.size()), gm = Eigen::VectorXd::Zero(x.size());
+      term.add_gradient(xp, gp);
+      term.add_gradient(xm, gm);
+      Hn.col(i) = (gp - gm) / (2 * h);
+    }
+    best_g = std::min(best_g, (gn - g).norm() / std::max(1e-12, g.norm()));
+    best_h = std::min(best_h, (Hn - Hd).norm() / std::max(1e-12, Hd.norm()));
+  }
+  EXPECT_LT(best_g, 1e-6) << term.name() << " gradient";
+  EXPECT_LT(best_h, 1e-6) << term.name() << " Hessian";
+}
+
+}  // namespace
+
+TEST(ElasticEnergy, ElementGradientAndHessianMatchFiniteDifferences) {
+  const TetMesh m = small_mesh();
+  const ElasticEnergy e(m, {StableNeoHookean(3400, 0.49)});
+  const Points x = perturbed(m, 0.004, 1);
+  for (Eigen::Index t : {0, 7, 23}) {
+    const Vec12 g = e.element_gradient(x, t);
+    const Mat12 H = e.element_hessian(x, t, false);
+    double best_g = 1e300, best_h = 1e300;
+    for (double h = 1e-4; h >= 1e-8; h *= 0.1) {
+      Vec12 gn;
+      Mat12 Hn;
+      for (int k = 0; k < 12; ++k) {
+        Points xp = x, xm = x;
+        xp(m.T(t, k / 3), k % 3) += h;
+        xm(m.T(t, k / 3), k % 3) -= h;
+        gn[k] = (e.element_value(xp, t) - e.element_value(xm, t)) / (2 * h);
+        Hn.col(k) = (e.element_gradient(xp, t) - e.element_gradient(xm, t)) / (2 * h);
+      }
+      best_g = std::min(best_g, (gn - g).norm() / g.norm());
+      best_h = std::min(best_h, (Hn - H).norm() / H.norm());
+    }
+    EXPECT_LT(best_g, 1e-7);
+    EXPECT_LT(best_h, 1e-7);
+  }
+}
+
+TEST(ElasticEnergy, AssembledGradientAndHessianMatchFiniteDifferences) {
+  const TetMesh m = small_mesh();
+  // Two materials, as for a stiffer tumour region.
+  std::vector<int> mat(m.T.rows(), 0);
+  for (size_t t = 0; t < mat.size(); t += 3) mat[t] = 1;
+  const ElasticEnergy e(m, {StableNeoHookean(3400, 0.49), StableNeoHookean(20000, 0.45)}, mat);
+  check_term(e, m, perturbed(m, 0.004, 2));
+}
+
+TEST(ElasticEnergy, ProjectedHessianIsPositiveSemiDefiniteUnderInversion) {
+  const TetMesh m = small_mesh();
+  const ElasticEnergy e(m, {StableNeoHookean(3400, 0.49)});
+  Points x = perturbed(m, 0.02, 3);  // large noise: many inverted elements
+  HessianAssembler H(static_cast<int>(m.V.rows()), m.T, {});
+  e.add_hessian(x, true, H);
+  const Eigen::MatrixXd Hd(H.matrix());
+  const double min_eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Hd).eigenvalues().minCoeff();
+  EXPECT_GE(min_eig, -1e-9 * Hd.norm());
+}
+
+TEST(GravityEnergy, GradientMatchesFiniteDifferencesAndMassIsConserved) {
+  const TetMesh m = small_mesh();
+  const GravityEnergy e(m, 1000, Vec3(0, 0, -9.81));
+  EXPECT_NEAR(e.masses().sum(), 1000 * 0.06 * 0.04 * 0.04, 1e-12);
+  check_term(e, m, perturbed(m, 0.004, 4));
+}
+
+TEST(PointConstraintEnergy, VertexTriangleAndTetAnchors) {
+  const TetMesh m = small_mesh();
+  PointConstraintEnergy e(1e4);
+  e.add(Anchor::vertex(5), Vec3(0.01, 0.02, 0.03));
+  e.add(triangle_anchor(m.T(4, 0), m.T(4, 1), m.T(4, 2)), Vec3(-0.01, 0.0, 0.05));
+  Anchor tet;
+  tet.count = 4;
+  for (int k = 0; k < 4; ++k) {
+    tet.v[k] = m.T(9, k);
+    tet.w[k] = 0.1 + 0.1 * k;
+  }
+  e.add(tet, Vec3(0.02, 0.02, 0.02));
+  check_term(e, m, perturbed(m, 0.004, 5));
+}
+
+TEST(PlaneConstraintEnergy, VertexAndTriangleAnchors) {
+  const TetMesh m = small_mesh();
+  PlaneConstraintEnergy e(1e4);
+  e.add(Anchor::vertex(3), Vec3(0.01, 0.02, 0.03), Vec3(1, 2, 2));
+  e.add(triangle_anchor(m.T(2, 0), m.T(2, 1), m.T(2, 3)), Vec3(0.0, 0.01, 0.0), Vec3(0, 0, 3));
+  check_term(e, m, perturbed(m, 0.004, 6));
+}
+
+TEST(Constraints, BadWeightsAndNormalsAreRejected) {
+  btr::test::expect_throw_with<InputError>([] { PointConstraintEnergy(-1); }, "weight must be finite and >= 0");
+  btr::test::expect_throw_with<InputError>([] { PlaneConstraintEnergy(std::nan("")); }, "weight must be finite");
+  PlaneConstraintEnergy p(1);
+  btr::test::expect_throw_with<InputError>([&] { p.add(Anchor::vertex(0), Vec3::Zero(), Vec3::Zero()); }, "non-zero normal");
+}
+
+TEST(TotalEnergy, SumOfTermsWithFixedVerticesEliminated) {
+  const TetMesh m = small_mesh();
+  TotalEnergy total;
+  total.add(std::make_shared<ElasticEnergy>(m, std::vector<StableNeoHookean>{StableNeoHookean(3400, 0.49)}));
+  total.add(std::make_shared<GravityEnergy>(m, 1000, Vec3(0, 0, -9.81)));
+  const Points x = perturbed(m, 0.003, 7);
+  std::vector<bool> fixed(m.V.rows(), false);
+  for (int v = 0; v < 12; ++v) fixed[v] = true;
+  HessianAssembler Hf(static_cast<int>(m.V.rows()), m.T, fixed), Ha(static_cast<int>(m.V.rows()), m.T, {});
+  total.hessian(x, false, Hf);
+  total.hessian(x, false, Ha);
+  EXPECT_EQ(Hf.num_free_dofs(), 3 * (static_cast<int>(m.V.rows()) - 12));
+  // The reduced matrix is the free-free block of the full one.
+  const Eigen::MatrixXd full(Ha.matrix()), red(Hf.matrix());
+  EXPECT_LT((full.bottomRightCorner(red.rows(), red.cols()) - red).norm(), 1e-9 * full.norm());
+}

@@ -1,0 +1,117 @@
+#include <memory>
+
+#include "breast_tumour_registration/core/box_mesh.h"
+#include "breast_tumour_registration/core/elastic_energy.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_energy.h"
+#include "breast_tumour_registration/core/newton_solver.h"
+#include "breast_tumour_registration/core/validation.h"
+#include "test_util.h"
+
+using namespace btr;
+
+namespace {
+
+std::vector<bool> boundary_mask(const TetMesh& m) {
+  std::vector<bool> b(m.V.rows(), false);
+  const Triangles F = boundary_faces(m);
+  for (Eigen::Index i = 0; i < F.size(); ++i) b[F.data()[i]] = true;
+  return b;
+}
+
+}  // namespace
+
+// Patch test: with the boundary moved by an affine map, a homogeneous hyperelastic body is
+// in equilibrium exactly when every interior vertex follows the same map (F is constant).
+TEST(NewtonSolver, PatchTestReproducesAnAffineDeformationExactly) {
+  const TetMesh m = make_box_tet_mesh(4, 4, 4, Vec3(0.04, 0.04, 0.04));
+  Mat3 A;
+  A << 1.3, 0.2, -0.1, 0.05, 0.8, 0.3, -0.2, 0.1, 1.1;  // large, non-symmetric, det > 0
+  const Vec3 b(0.01, -0.02, 0.005);
+  const std::vector<bool> fixed = boundary_mask(m);
+  Points x = m.V;
+  Points expected = m.V;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    expected.row(i) = (A * m.V.row(i).transpose() + b).transpose();
+    if (fixed[i]) x.row(i) = expected.row(i);
+  }
+  TotalEnergy energy;
+  energy.add(std::make_shared<ElasticEnergy>(m, std::vector<StableNeoHookean>{StableNeoHookean(5000, 0.45)}));
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, fixed), m.T);
+  NewtonOptions opt;
+  opt.gradient_rel_tolerance = 1e-13;
+  const NewtonResult r = solver.solve(energy, x, opt);
+  EXPECT_TRUE(r.converged) << to_string(r.reason);
+  EXPECT_LT((x - expected).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+TEST(NewtonSolver, EnergyNeverIncreasesAndCallbackSeesEveryIteration) {
+  const TetMesh m = make_box_tet_mesh(6, 2, 2, Vec3(0.12, 0.04, 0.04));
+  std::vector<bool> fixed(m.V.rows(), false);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) fixed[i] = m.V(i, 0) == 0.0;
+  TotalEnergy energy;
+  energy.add(std::make_shared<ElasticEnergy>(m, std::vector<StableNeoHookean>{StableNeoHookean(2000, 0.45)}));
+  auto gravity = std::make_shared<GravityEnergy>(m, 1000, Vec3(0, 0, -9.81));
+  energy.add(gravity);
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, fixed), m.T);
+  Points x = m.V;
+  int calls = 0;
+  double last = std::numeric_limits<double>::infinity();
+  NewtonOptions opt;
+  opt.callback = [&](const IterationInfo& it) {
+    ++calls;
+    EXPECT_LE(it.energy, last);
+    last = it.energy;
+    EXPECT_GT(it.elapsed, 0.0);
+    return true;
+  };
+  const NewtonResult r = solver.solve(energy, x, opt);
+  EXPECT_TRUE(r.converged) << to_string(r.reason);
+  EXPECT_EQ(calls, r.iterations);
+  EXPECT_LT(r.energy, r.initial_energy);
+  EXPECT_LE(r.gradient_norm, 1e-6 * r.initial_gradient_norm + 1e-10);
+  // Fixed vertices did not move; the free end sagged.
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    if (fixed[i]) {
+      EXPECT_EQ((x.row(i) - m.V.row(i)).norm(), 0.0);
+    }
+  EXPECT_LT(x.col(2).minCoeff(), -0.01);
+
+  // Warm start with the body's weight as force scale: the solution is accepted at once
+  // (the symbolic factorization is reused when it does iterate).
+  NewtonOptions warm;
+  warm.force_scale = gravity->total_weight();
+  const NewtonResult again = solver.solve(energy, x, warm);
+  EXPECT_TRUE(again.converged);
+  EXPECT_EQ(again.iterations, 0);
+  // Without a force scale the tolerance is relative to the (tiny) starting residual.
+  const NewtonResult tighter = solver.solve(energy, x, NewtonOptions{});
+  EXPECT_TRUE(tighter.converged);
+}
+
+TEST(NewtonSolver, CallbackCanAbort) {
+  const TetMesh m = make_box_tet_mesh(4, 2, 2, Vec3(0.08, 0.04, 0.04));
+  std::vector<bool> fixed(m.V.rows(), false);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) fixed[i] = m.V(i, 0) == 0.0;
+  TotalEnergy energy;
+  energy.add(std::make_shared<ElasticEnergy>(m, std::vector<StableNeoHookean>{StableNeoHookean(300, 0.45)}));
+  energy.add(std::make_shared<GravityEnergy>(m, 1000, Vec3(0, 0, -9.81)));
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, fixed), m.T);
+  Points x = m.V;
+  NewtonOptions opt;
+  opt.callback = [](const IterationInfo&) { return false; };
+  const NewtonResult r = solver.solve(energy, x, opt);
+  EXPECT_EQ(r.reason, StopReason::Aborted);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_FALSE(r.converged);
+}
+
+TEST(NewtonSolver, NonFiniteStartIsAClearError) {
+  const TetMesh m = make_box_tet_mesh(2, 2, 2, Vec3(0.04, 0.04, 0.04));
+  TotalEnergy energy;
+  energy.add(std::make_shared<ElasticEnergy>(m, std::vector<StableNeoHookean>{StableNeoHookean(3400, 0.49)}));
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, std::vector<bool>{}), m.T);
+  Points x = m.V;
+  x(3, 1) = std::numeric_limits<double>::quiet_NaN();
+  btr::test::expect_throw_with<SolverError>([&] { solver.solve(energy, x, NewtonOptions{}); }, "not finite");
+}
