@@ -1,0 +1,88 @@
+#include <set>
+
+#include "breast_tumour_registration/core/embedding.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_simulation.h"
+#include "breast_tumour_registration/core/phantom.h"
+#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/validation.h"
+#include "test_util.h"
+
+using namespace btr;
+
+namespace {
+
+const PhantomModel& coarse_phantom() {
+  static const PhantomModel m = [] {
+    PhantomOptions o;
+    o.tet.cell_size = 0.012;
+    o.surface_rings = 12;
+    return make_phantom_model(o);
+  }();
+  return m;
+}
+
+}  // namespace
+
+TEST(Phantom, HalfEllipsoidHasTheThesisSizeAndVolume) {
+  const SurfaceMesh s = make_half_ellipsoid(0.0745, 0.0745, 0.072, 24);
+  validate_surface(s, "half ellipsoid");
+  const Vec3 ext = (s.V.colwise().maxCoeff() - s.V.colwise().minCoeff()).transpose();
+  EXPECT_NEAR(ext.x(), 0.149, 1e-9);
+  EXPECT_NEAR(ext.y(), 0.149, 1e-3);  // rings sample y at 6k azimuths
+  EXPECT_NEAR(ext.z(), 0.072, 1e-12);
+  double vol = 0;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f)
+    vol += Vec3(s.V.row(s.F(f, 0))).dot(Vec3(s.V.row(s.F(f, 1))).cross(Vec3(s.V.row(s.F(f, 2))))) / 6.0;
+  EXPECT_NEAR(vol, 2.0 / 3.0 * M_PI * 0.0745 * 0.0745 * 0.072, 0.01 * vol);
+}
+
+TEST(Phantom, ModelHasChestWallLandmarksAndTumoursInside) {
+  const PhantomModel& m = coarse_phantom();
+  EXPECT_NO_THROW(validate_tet_mesh(m.rest, "phantom"));
+  for (int v : m.chest_wall) EXPECT_LT(std::abs(m.rest.V(v, 2)), 1e-9);
+  EXPECT_EQ(m.landmarks.size(), 13u);
+  std::set<int> distinct;
+  for (const auto& [name, v] : m.landmarks) {
+    distinct.insert(v);
+    EXPECT_GT(m.rest.V(v, 2), 0.005) << name << " should be on the skin, not the chest wall";
+  }
+  EXPECT_EQ(distinct.size(), 13u);
+  EXPECT_EQ(m.rest.V(m.landmarks.at("C"), 2), m.rest.V.col(2).maxCoeff());
+  for (const auto& name : phantom_tumour_names()) {
+    const Embedding e = embed_points(m.rest, m.tumours.at(name).V);
+    EXPECT_TRUE(e.outside.empty()) << name;
+  }
+  EXPECT_EQ(phantom_landmark_set("C+O").size(), 5u);
+  EXPECT_EQ(phantom_landmark_set("O+Oa+I").size(), 12u);
+  btr::test::expect_throw_with<InputError>([] { phantom_landmark_set("C,X9"); }, "unknown landmark");
+}
+
+TEST(Phantom, ProneHangsAndSupineFlattensWithTheChestWallFixed) {
+  const PhantomModel& m = coarse_phantom();
+  GravityProblem pb;
+  pb.rest = &m.rest;
+  pb.fixed = m.chest_wall;
+  pb.youngs_modulus = 3400;
+  const int apex = m.landmarks.at("C");
+  pb.gravity = Vec3(0, 0, 9.81);
+  const GravityResult prone = solve_gravity(pb, NewtonOptions{});
+  pb.gravity = Vec3(0, 0, -9.81);
+  const GravityResult supine = solve_gravity(pb, NewtonOptions{});
+  ASSERT_TRUE(prone.newton.converged);
+  ASSERT_TRUE(supine.newton.converged);
+  const double up = prone.x(apex, 2) - m.rest.V(apex, 2), down = supine.x(apex, 2) - m.rest.V(apex, 2);
+  std::printf("apex: prone %+.1f mm, supine %+.1f mm (%d + %d Newton iterations)\n", up * 1e3, down * 1e3,
+              prone.newton.iterations, supine.newton.iterations);
+  EXPECT_GT(up, 0.002);
+  EXPECT_LT(down, -0.002);
+  for (int v : m.chest_wall) {
+    EXPECT_EQ((prone.x.row(v) - m.rest.V.row(v)).norm(), 0.0);
+    EXPECT_EQ((supine.x.row(v) - m.rest.V.row(v)).norm(), 0.0);
+  }
+  // Stiffer tissue deforms less.
+  pb.youngs_modulus = 12000;
+  const GravityResult stiff = solve_gravity(pb, NewtonOptions{});
+  EXPECT_GT(stiff.x(apex, 2) - m.rest.V(apex, 2), down);
+}

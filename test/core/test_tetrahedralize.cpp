@@ -1,0 +1,88 @@
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/tetrahedralize.h"
+#include "breast_tumour_registration/core/validation.h"
+#include "test_util.h"
+
+using namespace btr;
+
+namespace {
+
+double enclosed_volume(const TetMesh& m) {
+  double v = 0;
+  for (Eigen::Index t = 0; t < m.T.rows(); ++t) v += tet_signed_volume(m.V, m.T, t);
+  return v;
+}
+
+}  // namespace
+
+TEST(Tetrahedralize, SphereIsFilledWithPositiveWellShapedTetrahedra) {
+  const double r = 0.05;
+  const SurfaceMesh s = make_icosphere(Vec3(0.01, 0.0, 0.02), r, 4);
+  TetrahedralizeOptions opt;
+  opt.cell_size = 0.012;
+  const TetMesh m = tetrahedralize(s, opt);
+  EXPECT_NO_THROW(validate_tet_mesh(m, "sphere"));
+  EXPECT_GT(m.T.rows(), 100);
+  EXPECT_NEAR(enclosed_volume(m), 4.0 / 3.0 * M_PI * r * r * r, 0.04 * 4.0 / 3.0 * M_PI * r * r * r);
+  const TetQuality q = tet_quality(m);
+  EXPECT_LT(q.median_radius_edge, 1.0);
+  EXPECT_GT(q.min_dihedral_deg, 1.0);  // sliver exudation
+  const TetMesh finer = tetrahedralize(s, TetrahedralizeOptions{0.006});
+  EXPECT_GT(finer.T.rows(), 4 * m.T.rows());
+}
+
+TEST(Tetrahedralize, BadOptionsAreRejected) {
+  const SurfaceMesh s = make_icosphere(Vec3::Zero(), 0.05, 1);
+  TetrahedralizeOptions opt;
+  opt.cell_size = -1;
+  btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); }, "cell_size must be positive");
+  opt.cell_size = 0.01;
+  opt.radius_edge_ratio = 0.5;
+  btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); }, "radius_edge_ratio");
+}
+
+// Landmarks are given as vertex indices of the input surface; Mesh_3 remeshes the boundary,
+// so each is re-attached as an exact barycentric point on the tet boundary.
+TEST(Tetrahedralize, LandmarkVerticesSurviveAsBoundaryAnchors) {
+  const double a = 0.0745, c = 0.072;
+  const SurfaceMesh s = make_half_ellipsoid(a, a, c, 12);
+  TetrahedralizeOptions opt;
+  opt.cell_size = 0.01;
+  const TetMesh m = tetrahedralize(s, opt);
+  const std::vector<int> landmark_vertices = {0, 5, 40, 100, 200};
+  Points P(landmark_vertices.size(), 3);
+  for (size_t i = 0; i < landmark_vertices.size(); ++i) P.row(i) = s.V.row(landmark_vertices[i]);
+  const BoundaryAttachment att = attach_to_boundary(m, P);
+  EXPECT_LE(att.max_distance, opt.facet_distance_ratio * opt.cell_size);
+  // The anchors are material points: they follow any deformation of the mesh exactly,
+  // e.g. an affine one.
+  Mat3 A;
+  A << 1.1, 0.1, 0, -0.05, 0.9, 0.2, 0, 0.1, 1.2;
+  const Vec3 b(0.01, 0.02, -0.01);
+  Points x = m.V;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) x.row(i) = (A * m.V.row(i).transpose() + b).transpose();
+  for (size_t i = 0; i < att.anchors.size(); ++i) {
+    const Vec3 rest = att.anchors[i].position(m.V);
+    EXPECT_NEAR((rest - P.row(i).transpose()).norm(), att.distances[i], 1e-12);
+    EXPECT_LT((att.anchors[i].position(x) - (A * rest + b)).norm(), 1e-12);
+  }
+}
+
+TEST(Tetrahedralize, ChestWallVerticesSurviveAsTheFlatBase) {
+  const double a = 0.0745, c = 0.072;
+  const SurfaceMesh s = make_half_ellipsoid(a, a, c, 12);
+  std::vector<int> chest;
+  for (Eigen::Index i = 0; i < s.V.rows(); ++i)
+    if (s.V(i, 2) == 0.0) chest.push_back(static_cast<int>(i));
+  const TetMesh m = tetrahedralize(s, TetrahedralizeOptions{0.01});
+  const std::vector<int> wall = boundary_vertices_near_region(m, s, chest, 1e-9);
+  ASSERT_GT(wall.size(), 20u);
+  int on_base = 0;
+  for (int v : boundary_vertices(m)) on_base += std::abs(m.V(v, 2)) < 1e-9;
+  EXPECT_EQ(static_cast<int>(wall.size()), on_base);
+  for (int v : wall) EXPECT_LT(std::abs(m.V(v, 2)), 1e-9);
+  btr::test::expect_throw_with<InputError>([&] { boundary_vertices_near_region(m, s, {0, 1}, 1e-9); },
+                                           "contains no complete face");
+}
