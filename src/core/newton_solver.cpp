@@ -30,6 +30,34 @@ std::string to_string(StopReason r) {
 struct NewtonSolver::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   bool analyzed = false;
+  bool have_factor = false;  // llt holds a factor of some earlier Hessian (same pattern)
+
+  // Preconditioned CG on H d = b with the lagged factor as preconditioner, started from
+  // the lagged Newton step M^-1 b. Returns false if the tolerance is not reached.
+  bool pcg(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, double rel_tol, int max_it,
+           Eigen::VectorXd& d, int& iterations) {
+    d = llt.solve(b);
+    Eigen::VectorXd r = b - H.selfadjointView<Eigen::Lower>() * d;
+    const double stop = rel_tol * b.norm();
+    iterations = 0;
+    if (r.norm() <= stop) return true;
+    Eigen::VectorXd z = llt.solve(r), p = z, Hp(b.size());
+    double rz = r.dot(z);
+    for (iterations = 1; iterations <= max_it; ++iterations) {
+      Hp.noalias() = H.selfadjointView<Eigen::Lower>() * p;
+      const double pHp = p.dot(Hp);
+      if (!(pHp > 0)) return false;
+      const double a = rz / pHp;
+      d += a * p;
+      r -= a * Hp;
+      if (r.norm() <= stop) return d.allFinite();
+      z = llt.solve(r);
+      const double rz_new = r.dot(z);
+      p = z + (rz_new / rz) * p;
+      rz = rz_new;
+    }
+    return false;
+  }
 };
 
 NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
@@ -69,31 +97,46 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     energy.hessian(x, opt.project_psd, H);
     info.t_assembly = since(t0);
 
-    t0 = Clock::now();
     auto& llt = impl_->llt;
-    if (!impl_->analyzed) {
-      llt.analyzePattern(H.matrix());
-      impl_->analyzed = true;
+    Eigen::VectorXd d;
+    bool solved = false;
+    if (opt.reuse_factorization && impl_->have_factor) {
+      t0 = Clock::now();
+      const double eta = std::min(opt.max_forcing, std::sqrt(g.norm() / std::max(res.initial_gradient_norm, 1e-300)));
+      solved = impl_->pcg(H.matrix(), -g, eta, opt.max_pcg_iterations, d, info.pcg_iterations);
+      info.t_solve = since(t0);
+      res.pcg_iterations += info.pcg_iterations;
     }
-    // The projected Hessian is PSD; with few constraints it can be singular, so a
-    // growing diagonal shift is tried before giving up.
-    double shift = 0;
-    const double diag_scale = H.matrix().diagonal().cwiseAbs().maxCoeff();
-    llt.setShift(0);
-    llt.factorize(H.matrix());
-    while (llt.info() != Eigen::Success) {
-      shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
-      if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30))
-        throw SolverError("Hessian could not be factorized even with a diagonal shift (non-finite entries?)");
-      llt.setShift(shift);
+    if (!solved) {
+      t0 = Clock::now();
+      if (!impl_->analyzed) {
+        llt.analyzePattern(H.matrix());
+        impl_->analyzed = true;
+      }
+      // The projected Hessian is PSD; with few constraints it can be singular, so a
+      // growing diagonal shift is tried before giving up.
+      double shift = 0;
+      const double diag_scale = H.matrix().diagonal().cwiseAbs().maxCoeff();
+      llt.setShift(0);
       llt.factorize(H.matrix());
-      ++res.regularizations;
+      while (llt.info() != Eigen::Success) {
+        shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
+        if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30)) {
+          impl_->have_factor = false;
+          throw SolverError("Hessian could not be factorized even with a diagonal shift (non-finite entries?)");
+        }
+        llt.setShift(shift);
+        llt.factorize(H.matrix());
+        ++res.regularizations;
+      }
+      impl_->have_factor = true;
+      ++res.factorizations;
+      info.factorized = true;
+      info.t_factorization = since(t0);
+      t0 = Clock::now();
+      d = -llt.solve(g);
+      info.t_solve += since(t0);
     }
-    info.t_factorization = since(t0);
-
-    t0 = Clock::now();
-    Eigen::VectorXd d = -llt.solve(g);
-    info.t_solve = since(t0);
     if (!d.allFinite()) throw SolverError("Newton direction is not finite");
 
     // Full step as vertex displacements.

@@ -31,6 +31,8 @@ struct IterationInfo {
   long inverted = 0;         ///< inverted tetrahedra after the step
   double elapsed = 0;        ///< seconds since the solve started
   double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< this iteration [s]
+  bool factorized = false;  ///< this iteration factorized (false: PCG on the lagged factor)
+  int pcg_iterations = 0;
 };
 
 struct NewtonOptions {
@@ -44,6 +46,14 @@ struct NewtonOptions {
   int max_line_search_steps = 40;
   double armijo = 1e-4;
   bool project_psd = true;
+  /// Reuse the last Cholesky factor as a preconditioner for conjugate gradients on the
+  /// new Hessian (inexact Newton); refactorize only when PCG does not reach the forcing
+  /// tolerance within max_pcg_iterations. Off: a fresh factorization every iteration.
+  bool reuse_factorization = true;
+  int max_pcg_iterations = 25;
+  /// Forcing term of the inexact Newton step: |H d + g| <= eta |g| with
+  /// eta = min(max_forcing, sqrt(|g| / |g0|)) (superlinear convergence).
+  double max_forcing = 0.1;
   /// Reject line-search steps that invert more tetrahedra than the current state has.
   bool forbid_new_inversions = true;
   /// Called after every accepted iteration; return false to abort.
@@ -60,6 +70,8 @@ struct NewtonResult {
   double seconds = 0;
   double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< totals [s]
   int regularizations = 0;  ///< factorizations that needed a diagonal shift
+  int factorizations = 0;    ///< numeric Cholesky factorizations
+  int pcg_iterations = 0;    ///< total preconditioned CG iterations (lagged-factor steps)
   std::vector<IterationInfo> history;
 };
 
