@@ -42,8 +42,19 @@ Mat12 ElasticEnergy::element_hessian(const Points& x, Eigen::Index t, bool proje
   const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
   const auto& mat = materials_[material_of_[t]];
   const Mat9 H9 = project_psd ? mat.clamped_hessian(F) : mat.hessian(F);
-  const Mat9x12 B = deformation_gradient_jacobian(rest_[t].Dm_inv);
-  return rest_[t].volume * (B.transpose() * H9 * B);
+  // dF/dx = G^T (x) I3 with G (4x3) the shape-function gradients, so block (a,b) of
+  // B^T H B is sum_jl G(a,j) G(b,l) H_jl (3x3 blocks of H9): a third of the dense flops.
+  const Mat3& Dinv = rest_[t].Dm_inv;
+  Eigen::Matrix<double, 4, 3> G;
+  G.bottomRows<3>() = Dinv;
+  G.row(0) = -Dinv.colwise().sum();
+  Eigen::Matrix<double, 9, 12> HG;  // HG.block(3j, 3b) = sum_l G(b,l) H_jl
+  for (int b = 0; b < 4; ++b)
+    HG.middleCols<3>(3 * b) = G(b, 0) * H9.middleCols<3>(0) + G(b, 1) * H9.middleCols<3>(3) + G(b, 2) * H9.middleCols<3>(6);
+  Mat12 K;
+  for (int a = 0; a < 4; ++a)
+    K.middleRows<3>(3 * a) = G(a, 0) * HG.middleRows<3>(0) + G(a, 1) * HG.middleRows<3>(3) + G(a, 2) * HG.middleRows<3>(6);
+  return rest_[t].volume * K;
 }
 
 double ElasticEnergy::value(const Points& x) const {

@@ -136,11 +136,13 @@ Mat9 StableNeoHookean::clamped_hessian(const Mat3& F) const {
   Vec9 eval;
   std::array<Mat3, 9> D;
   decompose(mu_, lambda_, F, U, V, eval, D);
-  Mat9 H = Mat9::Zero();
+  // H+ = H - sum over negative eigenpairs of lambda_k q_k q_k^T: near rest most elements
+  // have no negative eigenvalue, so this is much cheaper than summing nine outer products.
+  Mat9 H = hessian(F);
   for (int k = 0; k < 9; ++k) {
-    if (eval[k] <= 0) continue;
+    if (eval[k] >= 0) continue;
     const Mat3 Q = U * D[k] * V.transpose();
-    H.noalias() += eval[k] * vec(Q) * vec(Q).transpose();
+    H.noalias() -= eval[k] * vec(Q) * vec(Q).transpose();
   }
   return H;
 }
