@@ -3,7 +3,7 @@
 # the built-in default scene. Outputs go to out/demo (override with BTR_OUT).
 set -euo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BTR_ENABLE_TESTING=OFF bash "$REPO_ROOT/scripts/setup.sh"
+bash "$REPO_ROOT/scripts/setup.sh"
 OUT="${BTR_OUT:-$REPO_ROOT/out/demo}"
 BIN="$REPO_ROOT/build/ws/devel/lib/breast_tumour_registration"
 echo "[demo] generating the synthetic phantom (thesis Sec. 5.2.1, E = 3400 Pa) into $OUT"

@@ -39,4 +39,4 @@ JOBS="${BTR_JOBS:-$(nproc)}"
 cd "$WS"
 echo "[setup] building in $WS (Release, $JOBS jobs)"
 catkin_make -j"$JOBS" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
-  -DCATKIN_ENABLE_TESTING="${BTR_ENABLE_TESTING:-ON}" "$@"
+  -DCATKIN_ENABLE_TESTING=ON "$@"
