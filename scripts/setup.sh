@@ -13,7 +13,7 @@ DEB_PACKAGES=(
   libcgal-dev libsuitesparse-dev libeigen3-dev python3-rostest librostest-dev
   python3-rosbag librosbag-dev ros-message-generation libstd-srvs-dev python3-roslaunch
   libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
-  python3-matplotlib python3-numpy cmake g++ make time
+  python3-matplotlib python3-numpy zlib1g-dev cmake g++ make time
 )
 
 missing=()

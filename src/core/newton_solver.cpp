@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/line_search.h"
 #include "breast_tumour_registration/core/tet_kinematics.h"
 
 namespace btr {
@@ -25,6 +26,14 @@ std::string to_string(StopReason r) {
     case StopReason::Aborted: return "aborted by callback";
   }
   return "unknown";
+}
+
+LineSearchOptions line_search_options(const NewtonOptions& opt) {
+  LineSearchOptions l;
+  l.max_steps = opt.max_line_search_steps;
+  l.armijo = opt.armijo;
+  l.forbid_new_inversions = opt.forbid_new_inversions;
+  return l;
 }
 
 struct NewtonSolver::Impl {
@@ -151,41 +160,26 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     }
 
     t0 = Clock::now();
-    const double slope = g.dot(d);  // < 0 for a descent direction
-    double alpha = 1.0;
-    bool accepted = false;
-    double E_new = E;
-    long inv_new = n_inv;
-    for (int ls = 0; ls < opt.max_line_search_steps; ++ls, alpha *= 0.5) {
-      x_trial = x + alpha * dx;
-      E_new = energy.value(x_trial);
-      if (!std::isfinite(E_new) || E_new > E + opt.armijo * alpha * std::min(slope, 0.0)) continue;
-      if (opt.forbid_new_inversions) {
-        inv_new = inverted(x_trial);
-        if (inv_new > n_inv) continue;
-      }
-      accepted = true;
-      break;
-    }
+    const LineSearchResult ls =
+        backtracking_line_search(energy, x, dx, E, g.dot(d), n_inv, tets_, line_search_options(opt), x_trial);
     info.t_line_search = since(t0);
     res.t_assembly += info.t_assembly;
     res.t_factorization += info.t_factorization;
     res.t_solve += info.t_solve;
     res.t_line_search += info.t_line_search;
-    if (!accepted) {
+    if (!ls.accepted) {
       res.reason = StopReason::LineSearchFailed;
       break;
     }
     x.swap(x_trial);
-    E = E_new;
-    if (!opt.forbid_new_inversions) inv_new = inverted(x);
-    n_inv = inv_new;
+    E = ls.energy;
+    n_inv = ls.inverted;
     g = H.gather(energy.gradient(x));
 
     info.energy = E;
     info.gradient_norm = g.norm();
-    info.alpha = alpha;
-    info.step_norm = alpha * full_step;
+    info.alpha = ls.alpha;
+    info.step_norm = ls.alpha * full_step;
     info.inverted = n_inv;
     info.elapsed = since(t_start);
     res.iterations = it;

@@ -95,7 +95,7 @@ PhantomModel make_phantom_model(const PhantomOptions& opt) {
     if (centre.z() - r < 0.0) throw InputError("phantom: tumour '" + name + "' would cross the chest wall");
     m.tumours[name] = make_icosphere(centre, r, opt.tumour_subdivisions);
   }
-  m.chest_ring = make_elliptic_ring(a, b, opt.ring_width, 6 * opt.surface_rings);
+  m.chest_ring = make_chest_ring(a, b, opt.ring_width, 6 * opt.surface_rings);
   return m;
 }
 

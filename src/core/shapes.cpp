@@ -114,21 +114,26 @@ SurfaceMesh make_icosphere(const Vec3& centre, double radius, int subdivisions) 
   return assemble(v, f);
 }
 
-SurfaceMesh make_elliptic_ring(double a, double b, double width, int segments, double z0) {
-  if (!(a > 0 && b > 0 && width > 0) || segments < 3) throw InputError("elliptic ring needs positive sizes");
-  const double s = 1.0 + width / std::min(a, b);
+SurfaceMesh make_chest_ring(double a, double b, double width, int segments, double R) {
+  if (!(a > 0 && b > 0 && width > 0 && R > 0) || segments < 3) throw InputError("chest ring needs positive sizes");
+  const int radial = 6;
   std::vector<Vec3> v;
   std::vector<Eigen::Vector3i> f;
   for (int j = 0; j < segments; ++j) {
     const double phi = 2 * M_PI * j / segments;
-    v.emplace_back(a * std::cos(phi), b * std::sin(phi), z0);
-    v.emplace_back(s * a * std::cos(phi), s * b * std::sin(phi), z0);
+    for (int r = 0; r <= radial; ++r) {
+      const double d = width * r / radial;  // distance beyond the rim (along the ellipse normal, approx.)
+      const double s = 1.0 + d / std::min(a, b);
+      const double z = -d * d * (1.0 + 0.5 * std::cos(2 * phi)) / (2 * R);
+      v.emplace_back(s * a * std::cos(phi), s * b * std::sin(phi), z);
+    }
   }
-  for (int j = 0; j < segments; ++j) {
-    const int i0 = 2 * j, o0 = 2 * j + 1, i1 = 2 * ((j + 1) % segments), o1 = i1 + 1;
-    f.emplace_back(i0, o0, o1);
-    f.emplace_back(i0, o1, i1);
-  }
+  const auto id = [&](int j, int r) { return (j % segments) * (radial + 1) + r; };
+  for (int j = 0; j < segments; ++j)
+    for (int r = 0; r < radial; ++r) {
+      f.emplace_back(id(j, r), id(j, r + 1), id(j + 1, r + 1));
+      f.emplace_back(id(j, r), id(j + 1, r + 1), id(j + 1, r));
+    }
   return assemble(v, f);
 }
 

@@ -22,6 +22,8 @@ enum class StopReason {
 };
 std::string to_string(StopReason r);
 
+struct LineSearchOptions;
+
 struct IterationInfo {
   int iteration = 0;
   double energy = 0;         ///< after the step [J]
@@ -74,6 +76,9 @@ struct NewtonResult {
   int pcg_iterations = 0;    ///< total preconditioned CG iterations (lagged-factor steps)
   std::vector<IterationInfo> history;
 };
+
+/// The line-search part of the options.
+LineSearchOptions line_search_options(const NewtonOptions& opt);
 
 /// Newton solver bound to one sparsity pattern: the CHOLMOD symbolic analysis is done on
 /// the first solve and reused by every later solve with the same assembler.

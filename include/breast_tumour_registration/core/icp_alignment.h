@@ -1,0 +1,39 @@
+// Rigid refinement with PCL ICP (point-to-plane, median-distance correspondence rejection,
+// voxel-downsampled clouds, normals estimated on both cores) behind an interface without
+// PCL types, so that only icp_alignment.cpp pays PCL's compile time. Its result is
+// checked (convergence and inlier RMS), never trusted blindly.
+#pragma once
+
+#include <string>
+
+#include "breast_tumour_registration/core/rigid_transform.h"
+
+namespace btr {
+
+struct IcpOptions {
+  int max_iterations = 40;
+  double max_correspondence_distance = 0.01;  ///< [m]
+  double voxel_size = 0.003;                  ///< [m] downsampling; <= 0: none
+  int normal_neighbours = 12;
+  double transformation_epsilon = 1e-10;
+  double median_factor = 3.0;       ///< reject correspondences beyond this times the median distance
+  double max_inlier_rms = 0.002;    ///< [m] accept only below this
+  double min_overlap = 0.3;         ///< accept only when this fraction of source points has a correspondence
+};
+
+struct IcpResult {
+  Rigid transform = Rigid::Identity();  ///< maps source points onto the target (includes `initial`)
+  bool converged = false;     ///< PCL's own verdict
+  bool accepted = false;      ///< converged and within the RMS and overlap bounds
+  double inlier_rms = 0;      ///< [m] RMS distance of correspondences within max distance
+  double overlap = 0;         ///< fraction of source points within max distance after alignment
+  int iterations = 0;
+  double seconds = 0;
+  std::string message;        ///< why it was (not) accepted
+};
+
+/// Aligns `source` (rows are points, e.g. the supine rigid region) to `target` (e.g. the
+/// prone chest ring), starting from `initial`. Throws InputError for empty or NaN clouds.
+IcpResult align_icp(const Points& source, const Points& target, const Rigid& initial, const IcpOptions& opt);
+
+}  // namespace btr

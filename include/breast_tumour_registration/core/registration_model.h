@@ -1,0 +1,71 @@
+// The prepared prone model that every registration step works on: the prone tetrahedral
+// mesh as rest shape (thesis Sec. 5.2.3: the true rest shape is unknown), the fixed chest
+// wall, the skin, per-element materials (a stiffer tumour when asked) and the tumours
+// embedded barycentrically. Built once; the ROS node caches it.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/core/embedding.h"
+#include "breast_tumour_registration/core/newton_solver.h"
+#include "breast_tumour_registration/core/stable_neo_hookean.h"
+
+namespace btr {
+
+struct MaterialParameters {
+  double youngs_modulus = 3400;  ///< [Pa] (thesis: Hipwell et al. 2016)
+  double poisson_ratio = 0.49;
+  double density = 1000;         ///< [kg/m^3]
+};
+
+struct EmbeddedTumour {
+  std::string name;
+  SurfaceMesh prone;      ///< in the model frame
+  Embedding embedding;    ///< of prone.V in the rest mesh
+};
+
+struct RegistrationModel {
+  TetMesh rest;                    ///< prone tet mesh (rest shape), model frame [m]
+  std::vector<int> chest_wall;     ///< fixed vertices
+  std::vector<bool> fixed;         ///< #V flags
+  std::vector<int> skin;           ///< boundary vertices that are not fixed
+  std::vector<StableNeoHookean> materials;
+  std::vector<int> material_of;    ///< per tetrahedron
+  MaterialParameters material;
+  double volume = 0;               ///< [m^3]
+  Vec3 gravity = Vec3(0, 0, -9.81);///< supine gravity in the model frame [m/s^2]
+  std::vector<EmbeddedTumour> tumours;
+  long stiff_tetrahedra = 0;       ///< tetrahedra given the tumour material
+};
+
+/// Validates the mesh and indices and builds the model. Throws InputError on bad input.
+RegistrationModel make_registration_model(const TetMesh& prone, const std::vector<int>& chest_wall,
+                                          const MaterialParameters& material, const Vec3& gravity);
+
+/// Embeds a tumour (closed surface in the model frame). Outside vertices are attached to
+/// the nearest tetrahedron; the returned count says how many (the caller warns).
+int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceMesh& tumour);
+
+/// Gives the tetrahedra whose centroid lies inside any tumour the material with Young's
+/// modulus `youngs_modulus` (same nu); addresses the thesis's flattened tumours (Ch. 6).
+void stiffen_tumours(RegistrationModel& model, double youngs_modulus);
+
+/// Progress of a running step: step name and iteration; return false to abort.
+using StepCallback = std::function<bool(const std::string& step, const IterationInfo& it)>;
+
+struct StepReport {
+  std::string name;
+  bool converged = false;
+  std::string stop_reason;
+  int iterations = 0;        ///< Newton iterations (all outer loops)
+  int outer_iterations = 0;  ///< surface projections
+  double seconds = 0;
+  double energy = 0;
+  double gradient_norm = 0;
+  double projection_rms_change = 0;  ///< surface step: last RMS change of the projections [m]
+  double projection_max_change = 0;  ///< surface step: last max change [m]
+};
+
+}  // namespace btr

@@ -1,0 +1,83 @@
+// The scene-driven registration pipeline: it runs only the steps the scene's inputs call for
+// (rigid alignment, optional gravity pre-step, landmark-guided, surface-guided) and reports
+// the tumours in the supine frame with the figures of merit.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/core/icp_alignment.h"
+#include "breast_tumour_registration/core/landmark_step.h"
+#include "breast_tumour_registration/core/scene.h"
+#include "breast_tumour_registration/core/surface_step.h"
+
+namespace btr {
+
+struct RegistrationOptions {
+  std::string preset = "balanced";
+  IcpOptions icp;
+  LandmarkStepOptions landmark;
+  SurfaceStepOptions surface;
+  NewtonOptions gravity;  ///< gravity pre-step
+};
+
+/// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
+/// measured speed and accuracy of each). Throws InputError for another name.
+RegistrationOptions preset_options(const std::string& name);
+
+struct PlannedSteps {
+  bool rigid_landmarks = false;  ///< Kabsch on >= 3 landmark pairs
+  bool rigid_icp = false;        ///< ICP on prone and supine rigid regions
+  bool gravity = false;
+  bool landmarks = false;
+  bool surface = false;
+  std::string describe() const;
+};
+
+/// Steps for the scene: `auto` (scene.steps empty) takes every step its inputs allow
+/// (rigid when it has >= 3 landmarks or both rigid regions; landmarks; surface). An
+/// explicit list is checked against the inputs; a missing input is an InputError naming
+/// the field.
+PlannedSteps plan_steps(const Scene& scene);
+
+/// Builds the registration model of a scene (material, tumours embedded, stiffer tumour if
+/// asked). `warnings` receives messages about tumour points outside the mesh.
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings);
+
+struct TumourResult {
+  std::string name;
+  SurfaceMesh registered;   ///< supine frame
+  Vec3 centroid;            ///< supine frame [m]
+  double volume_ratio = 0;  ///< registered volume / prone volume
+  double axis_ratio = 0;    ///< shortest / longest principal axis of the registered tumour
+  double prone_axis_ratio = 0;  ///< the same for the prone tumour (flattening: axis_ratio < prone_axis_ratio)
+  bool has_ground_truth = false;
+  double centroid_distance = 0;  ///< [m] to the ground-truth centroid
+  double hausdorff = 0;          ///< [m]
+  double volume_ratio_to_truth = 0;
+  double truth_axis_ratio = 0;
+  double rigid_centroid_distance = 0;  ///< [m] prone tumour (rigidly aligned) to ground truth
+};
+
+struct RegistrationResult {
+  PlannedSteps steps;
+  Rigid supine_to_model = Rigid::Identity();  ///< the rigid alignment found
+  bool icp_used = false;
+  IcpResult icp;
+  double rigid_seconds = 0;
+  std::vector<StepReport> reports;
+  Points x;                 ///< deformed vertex positions, model frame
+  double seconds = 0;       ///< all steps, rigid alignment included
+  std::vector<TumourResult> tumours;
+  double landmark_residual_mean = 0, landmark_residual_max = 0;  ///< [m]
+  double skin_distance_mean = 0, skin_distance_max = 0;          ///< [m] to the supine surface
+  bool converged = true;
+  std::vector<std::string> warnings;
+};
+
+/// Runs the planned steps. Throws InputError for inconsistent inputs and SolverError for
+/// numerical failure; a step that stops without converging sets `converged = false`.
+RegistrationResult run_registration(const Scene& scene, const RegistrationModel& model, const RegistrationOptions& opt,
+                                    const StepCallback& callback = {});
+
+}  // namespace btr

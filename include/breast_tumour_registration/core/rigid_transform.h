@@ -1,0 +1,24 @@
+// Rigid transforms and the closed-form landmark alignment (Kabsch 1976 / Umeyama 1991
+// without scaling): the initial guess of the rigid alignment step.
+#pragma once
+
+#include <Eigen/Geometry>
+
+#include "breast_tumour_registration/core/types.h"
+
+namespace btr {
+
+using Rigid = Eigen::Isometry3d;
+
+/// R, t minimizing sum_i |R source_i + t - target_i|^2 (rows are corresponding points).
+/// Throws InputError for fewer than 3 pairs, NaN points, or collinear points.
+Rigid kabsch(const Points& source, const Points& target);
+
+/// Applies T to every row.
+Points transform_points(const Rigid& T, const Points& P);
+SurfaceMesh transform_surface(const Rigid& T, const SurfaceMesh& s);
+
+/// Rotation angle of T [rad] and translation length [m].
+double rotation_angle(const Rigid& T);
+
+}  // namespace btr

@@ -1,0 +1,64 @@
+// A registration scene (YAML): what is known about one patient (or phantom). Paths are
+// relative to the scene file; lengths in files use `units` and are converted once here.
+//
+//   units: mm                      # m or mm
+//   prone:
+//     tet_mesh: prone.vtk          # or `surface: prone.obj` to tetrahedralize (cell_size_mm)
+//     cell_size_mm: 6
+//   chest_wall: chest_wall.txt     # vertex indices of prone.tet_mesh (or of prone.surface)
+//   chest_ring: chest_ring.obj     # optional: prone rigid skin around the breast (for ICP)
+//   landmarks: landmarks.csv       # optional: prone index with supine index or supine x,y,z
+//   supine:
+//     surface: supine.obj          # optional: supine surface (closed mesh or open scan)
+//     chest_ring: ring.obj         # optional: supine rigid region (for ICP)
+//   tumours: [{name: t1, prone: t1.obj, supine_ground_truth: t1_supine.obj}]
+//   material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}
+//   tumour_material: {youngs_modulus: 17000}   # optional: stiffer tumour
+//   gravity: [0, 0, -9.81]         # supine gravity in the prone model frame [m/s^2]
+//   steps: auto                    # or a list of: rigid, gravity, landmarks, surface
+//   preset: balanced               # fast, balanced, accurate
+//   misalignment: {rotation_deg: [0, 0, 15], translation_mm: [0, 0, 0]}  # optional, experiments
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/core/energy_term.h"
+#include "breast_tumour_registration/core/registration_model.h"
+#include "breast_tumour_registration/core/rigid_transform.h"
+#include "breast_tumour_registration/core/units.h"
+
+namespace btr {
+
+struct SceneTumour {
+  std::string name;
+  SurfaceMesh prone;                               ///< model frame
+  std::optional<SurfaceMesh> supine_ground_truth;  ///< supine frame
+};
+
+struct Scene {
+  std::string path;
+  LengthUnit units = LengthUnit::Millimetre;
+  TetMesh prone;                         ///< model frame
+  bool tetrahedralized = false;          ///< prone came from a surface
+  double tetrahedralize_seconds = 0;
+  std::vector<int> chest_wall;           ///< prone tet vertex indices
+  std::vector<Anchor> landmark_anchors;  ///< prone landmark points
+  Points landmark_supine;                ///< supine landmark positions (supine frame), one row per anchor
+  std::optional<SurfaceMesh> supine_surface;  ///< supine frame
+  std::optional<SurfaceMesh> prone_rigid;     ///< model frame
+  std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
+  std::vector<SceneTumour> tumours;
+  MaterialParameters material;
+  std::optional<double> tumour_youngs_modulus;
+  Vec3 gravity = Vec3(0, 0, -9.81);
+  std::vector<std::string> steps;        ///< empty: auto
+  std::string preset = "balanced";
+  Rigid misalignment = Rigid::Identity();  ///< already applied to all supine data
+};
+
+/// Loads and validates a scene. Throws InputError naming the file and field at fault.
+Scene load_scene(const std::string& path);
+
+}  // namespace btr

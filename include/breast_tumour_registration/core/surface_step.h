@@ -1,0 +1,35 @@
+// Surface-guided deformation (thesis Sec. 4.4, Algorithm 2): the prone skin vertices (not
+// the chest wall, not the interior) are projected onto the supine surface (CGAL AABB tree);
+// soft point (eq. 4.2) and point-to-plane (eq. 4.3) springs hold them there while the
+// interior follows; the chest wall is fixed by eliminating its DOFs, so every system is
+// symmetric positive definite (the thesis solves a KKT system with LU instead). Projection
+// and Newton alternate until the projections stop moving.
+#pragma once
+
+#include "breast_tumour_registration/core/registration_model.h"
+
+namespace btr {
+
+struct SurfaceStepOptions {
+  double point_weight = 30;      ///< [N/m] per skin vertex: allows tangential sliding
+  double plane_weight = 3000;    ///< [N/m] per skin vertex: holds the skin on the surface
+  bool gravity = true;
+  int max_projections = 30;      ///< outer iterations (projection + Newton)
+  int newton_per_projection = 1; ///< Newton iterations between projections (thesis: 1)
+  /// [m] stop when the RMS change of the projections falls below this (the max is reported:
+  /// a few rim vertices keep flipping between the faces of a sharp edge).
+  double projection_tolerance = 2e-5;
+  /// When the projection budget runs out, the step still counts as converged if the last
+  /// RMS change was below this [m] (a preset that trades accuracy for speed); else it failed.
+  double budget_tolerance = 1e-4;
+  /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
+  double max_projection_distance = 0.03;
+  NewtonOptions newton;
+};
+
+/// supine: the supine surface in the model frame (closed or open, e.g. a scan).
+/// x: current positions, updated in place. Throws InputError for an empty surface.
+StepReport surface_step(const RegistrationModel& model, const SurfaceMesh& supine, const SurfaceStepOptions& opt,
+                        Points& x, const StepCallback& callback = {});
+
+}  // namespace btr

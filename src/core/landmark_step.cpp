@@ -1,0 +1,53 @@
+#include "breast_tumour_registration/core/landmark_step.h"
+
+#include <memory>
+
+#include "breast_tumour_registration/core/elastic_energy.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_energy.h"
+#include "breast_tumour_registration/core/point_constraint_energy.h"
+#include "breast_tumour_registration/core/subspace_solver.h"
+
+namespace btr {
+
+StepReport landmark_step(const RegistrationModel& model, const std::vector<Anchor>& anchors, const Points& targets,
+                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback) {
+  if (anchors.empty()) throw InputError("landmark step: no landmarks");
+  if (static_cast<Eigen::Index>(anchors.size()) != targets.rows())
+    throw InputError("landmark step: " + std::to_string(anchors.size()) + " prone landmarks but " +
+                     std::to_string(targets.rows()) + " supine targets");
+  TotalEnergy energy;
+  energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
+  auto gravity = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
+  if (opt.gravity) energy.add(gravity);
+  auto springs = std::make_shared<PointConstraintEnergy>(opt.weight);
+  std::vector<int> seeds;
+  std::vector<std::vector<int>> cliques;
+  for (size_t i = 0; i < anchors.size(); ++i) {
+    springs->add(anchors[i], targets.row(i).transpose());
+    // Seed the sampling with the anchor's dominant vertex (thesis: landmarks first).
+    int best = 0;
+    for (int k = 1; k < anchors[i].count; ++k)
+      if (anchors[i].w[k] > anchors[i].w[best]) best = k;
+    if (!model.fixed[anchors[i].v[best]]) seeds.push_back(anchors[i].v[best]);
+    cliques.emplace_back(anchors[i].v, anchors[i].v + anchors[i].count);
+  }
+  energy.add(springs);
+  const SkinningSubspace S = build_skinning_subspace(model.rest.V, model.volume, seeds, model.fixed, opt.subspace);
+  HessianAssembler H(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed, cliques);
+  NewtonOptions nopt = opt.newton;
+  if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
+  if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("landmark", it); };
+  const NewtonResult r = solve_subspace_newton(energy, H, S.basis, model.rest.T, x, nopt);
+  StepReport rep;
+  rep.name = "landmark";
+  rep.converged = r.converged;
+  rep.stop_reason = to_string(r.reason);
+  rep.iterations = r.iterations;
+  rep.seconds = r.seconds;
+  rep.energy = r.energy;
+  rep.gradient_norm = r.gradient_norm;
+  return rep;
+}
+
+}  // namespace btr

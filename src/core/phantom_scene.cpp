@@ -1,0 +1,127 @@
+#include "breast_tumour_registration/core/phantom_scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "breast_tumour_registration/core/embedding.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_simulation.h"
+#include "breast_tumour_registration/core/index_io.h"
+#include "breast_tumour_registration/core/mesh_io.h"
+#include "breast_tumour_registration/core/metrics.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+
+namespace btr {
+
+PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSceneOptions& opt,
+                                        const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
+  namespace fs = std::filesystem;
+  const auto landmark_names = phantom_landmark_set(opt.landmark_set);
+  StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio);  // validates before the expensive steps
+  fs::create_directories(dir);
+  const PhantomModel model = make_phantom_model(opt.phantom);
+  PhantomSceneSummary sum;
+  sum.vertices = model.rest.V.rows();
+  sum.tetrahedra = model.rest.T.rows();
+  sum.chest_wall_vertices = static_cast<long>(model.chest_wall.size());
+  sum.quality = tet_quality(model.rest);
+
+  auto solve = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
+    GravityProblem pb;
+    pb.rest = &model.rest;
+    pb.fixed = model.chest_wall;
+    pb.youngs_modulus = opt.youngs_modulus;
+    pb.poisson_ratio = opt.poisson_ratio;
+    pb.density = opt.density;
+    pb.gravity = g;
+    NewtonOptions newton;
+    if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
+    GravityResult r = solve_gravity(pb, newton);
+    if (!r.newton.converged) throw SolverError(name + " solve did not converge: " + to_string(r.newton.reason));
+    out = r.newton;
+    return r.x;
+  };
+  const Points prone = solve("prone", Vec3(0, 0, 9.81), sum.prone);
+  const Points supine = solve("supine", Vec3(0, 0, -9.81), sum.supine);
+
+  auto path = [&](const std::string& f) { return (fs::path(dir) / f).string(); };
+  const LengthUnit unit = opt.units;
+  write_surface(path("rest_surface.obj"), model.surface, unit);
+  write_tet_mesh(path("rest.vtk"), model.rest, unit);
+  write_index_list(path("chest_wall.txt"), model.chest_wall);
+  write_surface(path("chest_ring.obj"), model.chest_ring, unit);
+  TetMesh m = model.rest;
+  m.V = prone;
+  write_tet_mesh(path("prone.vtk"), m, unit);
+  write_surface(path("prone_surface.obj"), boundary_surface(m), unit);
+  m.V = supine;
+  write_tet_mesh(path("supine.vtk"), m, unit);
+  write_surface(path("supine_surface.obj"), boundary_surface(m), unit);
+
+  std::vector<LandmarkPair> pairs;
+  YAML::Node lm_vertices;
+  for (const auto& [name, v] : model.landmarks) lm_vertices[name] = v;
+  for (const auto& name : landmark_names) {
+    LandmarkPair p;
+    p.prone_vertex = model.landmarks.at(name);
+    p.supine_point = supine.row(p.prone_vertex).transpose();
+    pairs.push_back(p);
+  }
+  write_landmark_pairs(path("landmarks.csv"), pairs, unit);
+
+  YAML::Node tumours;
+  for (const auto& name : phantom_tumour_names()) {
+    const SurfaceMesh& t = model.tumours.at(name);
+    const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
+    const SurfaceMesh tp{apply_embedding(emb, model.rest.T, prone), t.F};
+    const SurfaceMesh ts{apply_embedding(emb, model.rest.T, supine), t.F};
+    write_surface(path("tumour_" + name + "_rest.obj"), t, unit);
+    write_surface(path("tumour_" + name + "_prone.obj"), tp, unit);
+    write_surface(path("tumour_" + name + "_supine.obj"), ts, unit);
+    YAML::Node n;
+    n["name"] = name;
+    n["prone"] = "tumour_" + name + "_prone.obj";
+    n["supine_ground_truth"] = "tumour_" + name + "_supine.obj";
+    n["rest"] = "tumour_" + name + "_rest.obj";
+    tumours.push_back(n);
+    sum.tumour_displacement.emplace_back(name, (volume_centroid(ts) - volume_centroid(tp)).norm());
+  }
+
+  YAML::Node scene;
+  scene["units"] = to_string(unit);
+  scene["frame"] = "chest wall in z = 0, breast towards +z; prone gravity +z, supine gravity -z";
+  scene["prone"]["tet_mesh"] = "prone.vtk";
+  scene["prone"]["surface"] = "prone_surface.obj";
+  scene["rest"]["tet_mesh"] = "rest.vtk";
+  scene["rest"]["surface"] = "rest_surface.obj";
+  scene["chest_wall"] = "chest_wall.txt";
+  scene["chest_ring"] = "chest_ring.obj";
+  scene["supine"]["surface"] = "supine_surface.obj";
+  scene["supine"]["chest_ring"] = "chest_ring.obj";
+  scene["supine"]["tet_mesh_ground_truth"] = "supine.vtk";
+  scene["landmarks"] = "landmarks.csv";
+  scene["landmark_set"] = opt.landmark_set;
+  scene["landmark_vertices"] = lm_vertices;
+  scene["tumours"] = tumours;
+  scene["material"]["youngs_modulus"] = 3400.0;
+  scene["material"]["poisson_ratio"] = 0.49;
+  scene["material"]["density"] = 1000.0;
+  scene["gravity"] = std::vector<double>{0.0, 0.0, -9.81};
+  scene["steps"] = "auto";
+  scene["preset"] = "balanced";
+  scene["generator"]["youngs_modulus"] = opt.youngs_modulus;
+  scene["generator"]["poisson_ratio"] = opt.poisson_ratio;
+  scene["generator"]["density"] = opt.density;
+  scene["generator"]["cell_size_mm"] = opt.phantom.tet.cell_size * 1e3;
+  scene["generator"]["tetrahedra"] = sum.tetrahedra;
+  YAML::Emitter y;
+  y << scene;
+  std::ofstream(path("scene.yaml")) << "# Synthetic breast phantom (thesis Sec. 5.2.1) written by btr_phantom\n"
+                                    << "# The registration uses the thesis's fixed material (E = 3400 Pa), not the generator's.\n"
+                                    << y.c_str() << "\n";
+  return sum;
+}
+
+}  // namespace btr

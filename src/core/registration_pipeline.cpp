@@ -1,0 +1,213 @@
+#include "breast_tumour_registration/core/registration_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_energy.h"
+#include "breast_tumour_registration/core/elastic_energy.h"
+#include "breast_tumour_registration/core/metrics.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+
+namespace btr {
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+bool requested(const Scene& s, const char* step) {
+  return std::find(s.steps.begin(), s.steps.end(), step) != s.steps.end();
+}
+}  // namespace
+
+RegistrationOptions preset_options(const std::string& name) {
+  RegistrationOptions o;
+  o.preset = name;
+  if (name == "fast") {
+    o.landmark.subspace.handles = 30;
+    o.landmark.newton.max_iterations = 4;
+    o.landmark.newton.gradient_rel_tolerance = 1e-3;
+    o.surface.max_projections = 3;
+    o.surface.newton_per_projection = 1;
+  } else if (name == "balanced") {
+    o.landmark.subspace.handles = 60;
+    o.landmark.newton.max_iterations = 10;
+    o.landmark.newton.gradient_rel_tolerance = 1e-4;
+    o.surface.max_projections = 6;
+    o.surface.newton_per_projection = 1;
+  } else if (name == "accurate") {
+    o.landmark.subspace.handles = 100;
+    o.landmark.newton.max_iterations = 30;
+    o.landmark.newton.gradient_rel_tolerance = 1e-6;
+    o.surface.max_projections = 40;
+    o.surface.newton_per_projection = 2;
+    o.surface.projection_tolerance = 1e-5;
+  } else {
+    throw InputError("unknown preset '" + name + "' (fast, balanced, accurate)");
+  }
+  return o;
+}
+
+std::string PlannedSteps::describe() const {
+  std::string s;
+  auto add = [&](bool on, const char* n) {
+    if (!on) return;
+    if (!s.empty()) s += " + ";
+    s += n;
+  };
+  add(rigid_landmarks, "rigid (landmarks)");
+  add(rigid_icp, "rigid (ICP)");
+  add(gravity, "gravity");
+  add(landmarks, "landmarks");
+  add(surface, "surface");
+  return s.empty() ? "none" : s;
+}
+
+PlannedSteps plan_steps(const Scene& s) {
+  PlannedSteps p;
+  const bool have_lm = s.landmark_anchors.size() > 0, have_rigid = s.prone_rigid && s.supine_rigid;
+  const bool auto_steps = s.steps.empty();
+  const std::string where = s.path + ": field 'steps': ";
+  if (auto_steps || requested(s, "rigid")) {
+    p.rigid_landmarks = s.landmark_anchors.size() >= 3;
+    p.rigid_icp = have_rigid;
+    if (!auto_steps && !p.rigid_landmarks && !p.rigid_icp)
+      throw InputError(where + "'rigid' needs >= 3 landmarks or both chest_ring and supine.chest_ring");
+  }
+  if (requested(s, "gravity")) p.gravity = true;
+  if (auto_steps ? have_lm : requested(s, "landmarks")) {
+    if (!have_lm) throw InputError(where + "'landmarks' needs the field 'landmarks'");
+    p.landmarks = true;
+  }
+  if (auto_steps ? bool(s.supine_surface) : requested(s, "surface")) {
+    if (!s.supine_surface) throw InputError(where + "'surface' needs the field 'supine.surface'");
+    p.surface = true;
+  }
+  if (!p.rigid_landmarks && !p.rigid_icp && !p.gravity && !p.landmarks && !p.surface)
+    throw InputError(s.path + ": nothing to do: the scene has no landmarks, no supine surface and no rigid regions");
+  return p;
+}
+
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings) {
+  RegistrationModel m = make_registration_model(scene.prone, scene.chest_wall, scene.material, scene.gravity);
+  for (const auto& t : scene.tumours) {
+    const int outside = add_tumour(m, t.name, t.prone);
+    if (outside > 0)
+      warnings.push_back("tumour '" + t.name + "': " + std::to_string(outside) +
+                         " vertices lie outside the prone mesh (up to " +
+                         std::to_string(m.tumours.back().embedding.max_outside_distance * 1e3) +
+                         " mm); they follow the nearest tetrahedron");
+  }
+  if (scene.tumour_youngs_modulus) {
+    stiffen_tumours(m, *scene.tumour_youngs_modulus);
+    if (m.stiff_tetrahedra == 0)
+      warnings.push_back("tumour_material: no tetrahedron centroid lies inside a tumour; refine the mesh");
+  }
+  return m;
+}
+
+RegistrationResult run_registration(const Scene& scene, const RegistrationModel& model, const RegistrationOptions& opt,
+                                    const StepCallback& callback) {
+  const auto t_start = Clock::now();
+  RegistrationResult r;
+  r.steps = plan_steps(scene);
+  r.x = model.rest.V;
+
+  // 1. Rigid alignment: Kabsch on the landmarks, then ICP on the rigid regions.
+  auto t0 = Clock::now();
+  Rigid T = Rigid::Identity();
+  if (r.steps.rigid_landmarks) {
+    Points prone_lm(scene.landmark_anchors.size(), 3);
+    for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
+      prone_lm.row(i) = scene.landmark_anchors[i].position(model.rest.V).transpose();
+    T = kabsch(scene.landmark_supine, prone_lm);
+  }
+  if (r.steps.rigid_icp) {
+    r.icp = align_icp(scene.supine_rigid->V, scene.prone_rigid->V, T, opt.icp);
+    const Rigid delta = r.icp.transform * T.inverse();
+    if (r.icp.accepted && rotation_angle(delta) < 45.0 * M_PI / 180.0 && delta.translation().norm() < 0.05) {
+      T = r.icp.transform;
+      r.icp_used = true;
+    } else {
+      r.warnings.push_back("rigid alignment: " + r.icp.message +
+                           (r.icp.accepted ? " but it moved too far from the initial guess" : "") +
+                           "; keeping the " + (r.steps.rigid_landmarks ? "landmark" : "identity") + " alignment");
+    }
+  }
+  r.supine_to_model = T;
+  r.rigid_seconds = since(t0);
+  Points targets = scene.landmark_supine.rows() ? transform_points(T, scene.landmark_supine) : Points();
+  std::optional<SurfaceMesh> supine_surface;
+  if (scene.supine_surface) supine_surface = transform_surface(T, *scene.supine_surface);
+
+  // 2. Optional gravity pre-step (thesis Sec. 5.2.2: gravity + surface).
+  if (r.steps.gravity) {
+    const auto tg = Clock::now();
+    TotalEnergy energy;
+    energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
+    auto g = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
+    energy.add(g);
+    NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed),
+                        model.rest.T);
+    NewtonOptions nopt = opt.gravity;
+    nopt.force_scale = g->total_weight();
+    if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("gravity", it); };
+    const NewtonResult nr = solver.solve(energy, r.x, nopt);
+    StepReport rep;
+    rep.name = "gravity";
+    rep.converged = nr.converged;
+    rep.stop_reason = to_string(nr.reason);
+    rep.iterations = nr.iterations;
+    rep.seconds = since(tg);
+    rep.energy = nr.energy;
+    rep.gradient_norm = nr.gradient_norm;
+    r.reports.push_back(rep);
+  }
+  // 3. Landmark-guided step.
+  if (r.steps.landmarks) r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback));
+  // 4. Surface-guided step.
+  if (r.steps.surface) r.reports.push_back(surface_step(model, *supine_surface, opt.surface, r.x, callback));
+  for (const auto& rep : r.reports) r.converged = r.converged && rep.converged;
+  r.seconds = since(t_start);
+
+  // Outputs in the supine frame and figures of merit.
+  const Rigid to_supine = T.inverse();
+  for (size_t i = 0; i < model.tumours.size(); ++i) {
+    const auto& mt = model.tumours[i];
+    TumourResult tr;
+    tr.name = mt.name;
+    tr.registered = transform_surface(to_supine, {apply_embedding(mt.embedding, model.rest.T, r.x), mt.prone.F});
+    tr.centroid = volume_centroid(tr.registered);
+    tr.volume_ratio = enclosed_volume(tr.registered) / enclosed_volume(mt.prone);
+    tr.axis_ratio = principal_axis_ratio(tr.registered);
+    tr.prone_axis_ratio = principal_axis_ratio(mt.prone);
+    const auto& gt = scene.tumours[i].supine_ground_truth;
+    if (gt) {
+      tr.has_ground_truth = true;
+      tr.centroid_distance = (tr.centroid - volume_centroid(*gt)).norm();
+      tr.hausdorff = hausdorff_distance(tr.registered, *gt);
+      tr.volume_ratio_to_truth = enclosed_volume(tr.registered) / enclosed_volume(*gt);
+      tr.truth_axis_ratio = principal_axis_ratio(*gt);
+      tr.rigid_centroid_distance = (to_supine * volume_centroid(mt.prone) - volume_centroid(*gt)).norm();
+    }
+    r.tumours.push_back(tr);
+  }
+  if (targets.rows()) {
+    std::vector<double> d;
+    for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
+      d.push_back((scene.landmark_anchors[i].position(r.x) - targets.row(i).transpose()).norm());
+    const DistanceStats st = distance_stats(d);
+    r.landmark_residual_mean = st.mean;
+    r.landmark_residual_max = st.max;
+  }
+  if (supine_surface) {
+    Points skin(model.skin.size(), 3);
+    for (size_t i = 0; i < model.skin.size(); ++i) skin.row(i) = r.x.row(model.skin[i]);
+    const DistanceStats st = distance_stats(point_to_surface_distances(skin, *supine_surface));
+    r.skin_distance_mean = st.mean;
+    r.skin_distance_max = st.max;
+  }
+  return r;
+}
+
+}  // namespace btr

@@ -1,0 +1,230 @@
+#include "breast_tumour_registration/core/scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/index_io.h"
+#include "breast_tumour_registration/core/mesh_io.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/tetrahedralize.h"
+#include "breast_tumour_registration/core/validation.h"
+
+namespace btr {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Ctx {
+  std::string file;
+  fs::path dir;
+  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+    throw InputError(file + ": field '" + field + "': " + what);
+  }
+  std::string path_of(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail(field, "expected a file name");
+    const fs::path p(n.as<std::string>());
+    return (p.is_absolute() ? p : dir / p).string();
+  }
+  double number(const YAML::Node& n, const std::string& field) const {
+    try {
+      return n.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(field, "expected a number");
+    }
+  }
+  Vec3 vec3(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsSequence() || n.size() != 3) fail(field, "expected a list of 3 numbers");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = number(n[i], field);
+    if (!v.allFinite()) fail(field, "values must be finite");
+    return v;
+  }
+  // Runs a loader and prefixes its error with the field name.
+  template <class F>
+  auto load(const std::string& field, F&& f) const -> decltype(f()) {
+    try {
+      return f();
+    } catch (const InputError& e) {
+      fail(field, e.what());
+    }
+  }
+};
+
+}  // namespace
+
+Scene load_scene(const std::string& path) {
+  Ctx c{path, fs::path(path).parent_path()};
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw InputError("cannot open scene '" + path + "': file missing or unreadable");
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ": YAML syntax error: " + e.what());
+  }
+  if (!root.IsMap()) throw InputError(path + ": a scene is a YAML mapping of fields");
+  Scene s;
+  s.path = path;
+  if (root["units"]) s.units = c.load("units", [&] { return parse_length_unit(root["units"].as<std::string>()); });
+  const double m_per_unit = metres_per_unit(s.units);
+
+  // Prone model.
+  const YAML::Node prone = root["prone"];
+  if (!prone || !prone.IsMap()) c.fail("prone", "missing; give prone.tet_mesh or prone.surface");
+  SurfaceMesh prone_surface;
+  bool have_surface = false;
+  TetrahedralizeOptions topt;
+  if (prone["surface"]) {
+    prone_surface = c.load("prone.surface", [&] { return read_surface(c.path_of(prone["surface"], "prone.surface"), s.units); });
+    have_surface = true;
+  }
+  if (prone["tet_mesh"]) {
+    s.prone = c.load("prone.tet_mesh", [&] {
+      TetMesh m = read_tet_mesh(c.path_of(prone["tet_mesh"], "prone.tet_mesh"), s.units);
+      orient_tets_positive(m);
+      validate_tet_mesh(m, "prone.tet_mesh");
+      return m;
+    });
+  } else if (have_surface) {
+    c.load("prone.surface", [&] { validate_surface(prone_surface, "prone.surface"); return 0; });
+    topt.cell_size = (prone["cell_size_mm"] ? c.number(prone["cell_size_mm"], "prone.cell_size_mm") : 6.0) * 1e-3;
+    const auto t0 = std::chrono::steady_clock::now();
+    s.prone = c.load("prone.cell_size_mm", [&] { return tetrahedralize(prone_surface, topt); });
+    s.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    s.tetrahedralized = true;
+  } else {
+    c.fail("prone", "give prone.tet_mesh or prone.surface");
+  }
+
+  // Chest wall: tet vertex indices, or surface indices re-attached after tetrahedralization.
+  if (!root["chest_wall"]) c.fail("chest_wall", "missing: the fixed chest-wall vertices are required");
+  const std::vector<int> wall = c.load("chest_wall", [&] { return read_index_list(c.path_of(root["chest_wall"], "chest_wall")); });
+  if (s.tetrahedralized) {
+    c.load("chest_wall", [&] { check_index_range(wall, prone_surface.V.rows(), "chest_wall"); return 0; });
+    s.chest_wall = c.load("chest_wall", [&] {
+      return boundary_vertices_near_region(s.prone, prone_surface, wall, 1e-6 + topt.facet_distance_ratio * topt.cell_size);
+    });
+  } else {
+    c.load("chest_wall", [&] { check_index_range(wall, s.prone.V.rows(), "chest_wall"); return 0; });
+    s.chest_wall = wall;
+  }
+
+  // Supine data (loaded in the supine frame; the misalignment is applied afterwards).
+  const YAML::Node supine = root["supine"];
+  if (supine && supine["surface"]) {
+    s.supine_surface = c.load("supine.surface", [&] {
+      SurfaceMesh m = read_surface(c.path_of(supine["surface"], "supine.surface"), s.units);
+      SurfaceCheckOptions o;
+      o.require_closed = false;  // a scan may be open
+      o.require_consistent_orientation = false;
+      validate_surface(m, "supine.surface", o);
+      return m;
+    });
+  }
+  if (supine && supine["chest_ring"])
+    s.supine_rigid = c.load("supine.chest_ring", [&] { return read_surface(c.path_of(supine["chest_ring"], "supine.chest_ring"), s.units); });
+  if (root["chest_ring"])
+    s.prone_rigid = c.load("chest_ring", [&] { return read_surface(c.path_of(root["chest_ring"], "chest_ring"), s.units); });
+
+  // Landmarks.
+  if (root["landmarks"]) {
+    const auto pairs = c.load("landmarks", [&] { return read_landmark_pairs(c.path_of(root["landmarks"], "landmarks"), s.units); });
+    Points prone_pts(pairs.size(), 3);
+    s.landmark_supine.resize(pairs.size(), 3);
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      const auto& p = pairs[i];
+      const long n_prone = s.tetrahedralized ? prone_surface.V.rows() : s.prone.V.rows();
+      if (p.prone_vertex >= n_prone)
+        c.fail("landmarks", "pair " + std::to_string(i) + ": prone vertex " + std::to_string(p.prone_vertex) +
+                                " out of range (" + std::to_string(n_prone) + " vertices)");
+      if (p.supine_vertex >= 0) {
+        if (!s.supine_surface) c.fail("landmarks", "pair " + std::to_string(i) + " names a supine vertex but there is no supine.surface");
+        if (p.supine_vertex >= s.supine_surface->V.rows())
+          c.fail("landmarks", "pair " + std::to_string(i) + ": supine vertex " + std::to_string(p.supine_vertex) + " out of range");
+        s.landmark_supine.row(i) = s.supine_surface->V.row(p.supine_vertex);
+      } else {
+        s.landmark_supine.row(i) = p.supine_point.transpose();
+      }
+      if (s.tetrahedralized) prone_pts.row(i) = prone_surface.V.row(p.prone_vertex);
+      else s.landmark_anchors.push_back(Anchor::vertex(p.prone_vertex));
+    }
+    if (s.tetrahedralized) s.landmark_anchors = attach_to_boundary(s.prone, prone_pts).anchors;
+  }
+
+  // Tumours.
+  if (root["tumours"]) {
+    if (!root["tumours"].IsSequence()) c.fail("tumours", "expected a list of {name, prone, supine_ground_truth}");
+    int i = 0;
+    for (const auto& t : root["tumours"]) {
+      const std::string f = "tumours[" + std::to_string(i++) + "]";
+      SceneTumour st;
+      st.name = t["name"] ? t["name"].as<std::string>() : "tumour" + std::to_string(i - 1);
+      if (!t["prone"]) c.fail(f + ".prone", "missing tumour surface");
+      st.prone = c.load(f + ".prone", [&] {
+        SurfaceMesh m = read_surface(c.path_of(t["prone"], f + ".prone"), s.units);
+        validate_surface(m, f + ".prone");
+        return m;
+      });
+      if (t["supine_ground_truth"])
+        st.supine_ground_truth = c.load(f + ".supine_ground_truth", [&] {
+          return read_surface(c.path_of(t["supine_ground_truth"], f + ".supine_ground_truth"), s.units);
+        });
+      s.tumours.push_back(std::move(st));
+    }
+  }
+
+  // Material, gravity, steps, preset.
+  if (const YAML::Node m = root["material"]) {
+    if (m["youngs_modulus"]) s.material.youngs_modulus = c.number(m["youngs_modulus"], "material.youngs_modulus");
+    if (m["poisson_ratio"]) s.material.poisson_ratio = c.number(m["poisson_ratio"], "material.poisson_ratio");
+    if (m["density"]) s.material.density = c.number(m["density"], "material.density");
+  }
+  c.load("material", [&] { StableNeoHookean(s.material.youngs_modulus, s.material.poisson_ratio); return 0; });
+  if (!(s.material.density > 0)) c.fail("material.density", "must be positive (kg/m^3)");
+  if (const YAML::Node m = root["tumour_material"]) {
+    s.tumour_youngs_modulus = c.number(m["youngs_modulus"], "tumour_material.youngs_modulus");
+    c.load("tumour_material", [&] { StableNeoHookean(*s.tumour_youngs_modulus, s.material.poisson_ratio); return 0; });
+  }
+  if (root["gravity"]) s.gravity = c.vec3(root["gravity"], "gravity");
+  if (const YAML::Node st = root["steps"]) {
+    if (st.IsScalar() && st.as<std::string>() == "auto") {
+    } else if (st.IsSequence()) {
+      for (const auto& n : st) {
+        const std::string name = n.as<std::string>();
+        if (name != "rigid" && name != "gravity" && name != "landmarks" && name != "surface")
+          c.fail("steps", "unknown step '" + name + "' (rigid, gravity, landmarks, surface)");
+        s.steps.push_back(name);
+      }
+      if (s.steps.empty()) c.fail("steps", "empty list; use 'auto' or name the steps");
+    } else {
+      c.fail("steps", "expected 'auto' or a list of steps");
+    }
+  }
+  if (root["preset"]) s.preset = root["preset"].as<std::string>();
+  if (s.preset != "fast" && s.preset != "balanced" && s.preset != "accurate")
+    c.fail("preset", "unknown preset '" + s.preset + "' (fast, balanced, accurate)");
+
+  // Simulated misalignment of the supine data (experiments of thesis Sec. 5.2.5).
+  if (const YAML::Node mis = root["misalignment"]) {
+    Vec3 rot = Vec3::Zero(), tr = Vec3::Zero();
+    if (mis["rotation_deg"]) rot = c.vec3(mis["rotation_deg"], "misalignment.rotation_deg") * M_PI / 180.0;
+    if (mis["translation_mm"]) tr = c.vec3(mis["translation_mm"], "misalignment.translation_mm") * 1e-3;
+    s.misalignment = Rigid::Identity();
+    s.misalignment.linear() = (Eigen::AngleAxisd(rot.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rot.y(), Vec3::UnitY()) *
+                               Eigen::AngleAxisd(rot.x(), Vec3::UnitX())).toRotationMatrix();
+    s.misalignment.translation() = tr;
+    if (s.supine_surface) s.supine_surface = transform_surface(s.misalignment, *s.supine_surface);
+    if (s.supine_rigid) s.supine_rigid = transform_surface(s.misalignment, *s.supine_rigid);
+    if (s.landmark_supine.rows()) s.landmark_supine = transform_points(s.misalignment, s.landmark_supine);
+    for (auto& t : s.tumours)
+      if (t.supine_ground_truth) t.supine_ground_truth = transform_surface(s.misalignment, *t.supine_ground_truth);
+  }
+  (void)m_per_unit;
+  return s;
+}
+
+}  // namespace btr

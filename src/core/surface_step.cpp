@@ -1,0 +1,95 @@
+#include "breast_tumour_registration/core/surface_step.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "breast_tumour_registration/core/closest_point.h"
+#include "breast_tumour_registration/core/elastic_energy.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/gravity_energy.h"
+#include "breast_tumour_registration/core/plane_constraint_energy.h"
+#include "breast_tumour_registration/core/point_constraint_energy.h"
+
+namespace btr {
+
+StepReport surface_step(const RegistrationModel& model, const SurfaceMesh& supine, const SurfaceStepOptions& opt,
+                        Points& x, const StepCallback& callback) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (supine.F.rows() == 0) throw InputError("surface step: the supine surface has no faces");
+  if (!supine.V.allFinite()) throw InputError("surface step: the supine surface has NaN coordinates");
+  if (opt.max_projections < 1 || opt.newton_per_projection < 1)
+    throw InputError("surface step: max_projections and newton_per_projection must be >= 1");
+  const SurfaceClosestPoint cp(supine.V, supine.F);
+
+  TotalEnergy energy;
+  energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
+  auto gravity = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
+  if (opt.gravity) energy.add(gravity);
+  auto points = std::make_shared<PointConstraintEnergy>(opt.point_weight);
+  auto planes = std::make_shared<PlaneConstraintEnergy>(opt.plane_weight);
+  energy.add(points);
+  energy.add(planes);
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed),
+                      model.rest.T);
+  NewtonOptions nopt = opt.newton;
+  nopt.max_iterations = opt.newton_per_projection;
+  if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
+
+  StepReport rep;
+  rep.name = "surface";
+  Points targets = Points::Zero(static_cast<Eigen::Index>(model.skin.size()), 3);
+  int offset = 0;
+  for (int outer = 1; outer <= opt.max_projections; ++outer) {
+    points->clear();
+    planes->clear();
+    double moved = 0, moved_sq = 0;
+    int kept = 0;
+    for (size_t i = 0; i < model.skin.size(); ++i) {
+      const int v = model.skin[i];
+      const ClosestPoint c = cp.query(x.row(v).transpose());
+      const double m = (c.point - targets.row(i).transpose()).norm();
+      moved = std::max(moved, m);
+      moved_sq += m * m;
+      targets.row(i) = c.point.transpose();
+      if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) continue;
+      points->add(Anchor::vertex(v), c.point);
+      planes->add(Anchor::vertex(v), c.point, cp.face_normal(c.face));
+      ++kept;
+    }
+    const double moved_rms = std::sqrt(moved_sq / static_cast<double>(model.skin.size()));
+    rep.projection_rms_change = moved_rms;
+    rep.projection_max_change = moved;
+    if (kept == 0)
+      throw InputError("surface step: no skin vertex is within " + std::to_string(opt.max_projection_distance) +
+                       " m of the supine surface; is the scan aligned with the model?");
+    if (callback) nopt.callback = [&](const IterationInfo& it) {
+      IterationInfo shifted = it;
+      shifted.iteration += offset;
+      return callback("surface", shifted);
+    };
+    const NewtonResult r = solver.solve(energy, x, nopt);
+    offset += r.iterations;
+    rep.iterations += r.iterations;
+    rep.outer_iterations = outer;
+    rep.energy = r.energy;
+    rep.gradient_norm = r.gradient_norm;
+    rep.stop_reason = to_string(r.reason);
+    if (r.reason == StopReason::Aborted) break;
+    if (outer > 1 && moved_rms <= opt.projection_tolerance && r.converged) {
+      rep.converged = true;
+      rep.stop_reason = "projections stopped moving";
+      break;
+    }
+  }
+  if (!rep.converged && rep.stop_reason != to_string(StopReason::Aborted)) {
+    rep.converged = rep.projection_rms_change <= opt.budget_tolerance;
+    rep.stop_reason = std::string("projection budget reached, last RMS change ") +
+                      std::to_string(rep.projection_rms_change * 1e3) + " mm" +
+                      (rep.converged ? " (within the budget tolerance)" : " (above the budget tolerance)");
+  }
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return rep;
+}
+
+}  // namespace btr

@@ -1,0 +1,108 @@
+// btr_register: runs the prone-to-supine registration of a scene file (YAML) and writes the
+// registered meshes, tumours, report.json and cross_section.png.
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <unistd.h>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/registration_report.h"
+
+using namespace btr;
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Deform the prone breast model of a scene into the supine position (Yeh 2023: rigid alignment, landmark-guided\n"
+      "subspace step, surface-guided step) and write the registered tumour(s), meshes, report.json and a PNG.\n"
+      "Exit codes: 0 converged, 2 invalid input, 3 numerical failure, 4 finished without converging (outputs written)."};
+  std::string scene_path, out_dir = "registration", preset, steps;
+  double tumour_E = 0;
+  bool quiet = false;
+  app.add_option("scene", scene_path, "scene file (YAML), e.g. written by btr_phantom")->required();
+  app.add_option("-o,--out", out_dir, "output folder (created)")->capture_default_str();
+  app.add_option("-p,--preset", preset, "fast, balanced or accurate (default: the scene's, else balanced)");
+  app.add_option("-s,--steps", steps, "override the scene's steps: auto, or a comma list of rigid,gravity,landmarks,surface");
+  app.add_option("--tumour-youngs-modulus", tumour_E, "give tumour elements this Young's modulus [Pa] (stiffer tumour)");
+  app.add_flag("-q,--quiet", quiet, "no progress display");
+  CLI11_PARSE(app, argc, argv);
+
+  const bool tty = isatty(fileno(stdout));
+  try {
+    auto t0 = std::chrono::steady_clock::now();
+    Scene scene = load_scene(scene_path);
+    if (!preset.empty()) scene.preset = preset;
+    if (!steps.empty()) {
+      scene.steps.clear();
+      if (steps != "auto") {
+        std::stringstream ss(steps);
+        std::string s;
+        while (std::getline(ss, s, ','))
+          if (s == "rigid" || s == "gravity" || s == "landmarks" || s == "surface") scene.steps.push_back(s);
+          else throw InputError("--steps: unknown step '" + s + "' (rigid, gravity, landmarks, surface)");
+      }
+    }
+    if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
+    const RegistrationOptions opt = preset_options(scene.preset);
+    const PlannedSteps plan = plan_steps(scene);
+    std::vector<std::string> warnings;
+    const RegistrationModel model = prepare_model(scene, warnings);
+    const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("[register] %s: %ld vertices, %ld tetrahedra%s; steps: %s; preset %s\n", scene_path.c_str(),
+                static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows()),
+                scene.tetrahedralized ? " (tetrahedralized)" : "", plan.describe().c_str(), scene.preset.c_str());
+    for (const auto& w : warnings) std::printf("[register] warning: %s\n", w.c_str());
+
+    StepCallback progress;
+    if (!quiet)
+      progress = [&](const std::string& step, const IterationInfo& it) {
+        std::printf("%s[%-8s] iteration %3d  energy %+.6e J  |grad| %.2e N  step %.3f mm  %.2f s%s", tty ? "\r" : "",
+                    step.c_str(), it.iteration, it.energy, it.gradient_norm, it.step_norm * 1e3, it.elapsed, tty ? "" : "\n");
+        std::fflush(stdout);
+        return true;
+      };
+    RegistrationResult r = run_registration(scene, model, opt, progress);
+    r.warnings.insert(r.warnings.begin(), warnings.begin(), warnings.end());
+    if (tty && !quiet) std::printf("\n");
+    if (plan.rigid_landmarks || plan.rigid_icp)
+      std::printf("[rigid   ] %.2f deg, %.2f mm (%s) in %.3f s\n", rotation_angle(r.supine_to_model) * 180 / M_PI,
+                  r.supine_to_model.translation().norm() * 1e3, r.icp_used ? "landmarks + ICP" : r.icp.message.empty() ? "landmarks" : r.icp.message.c_str(),
+                  r.rigid_seconds);
+    for (const auto& s : r.reports)
+      std::printf("[%-8s] %s: %d Newton iterations%s in %.3f s\n", s.name.c_str(), s.stop_reason.c_str(), s.iterations,
+                  s.outer_iterations ? (", " + std::to_string(s.outer_iterations) + " projections").c_str() : "", s.seconds);
+    for (const auto& w : r.warnings)
+      if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) std::printf("[register] warning: %s\n", w.c_str());
+    for (const auto& t : r.tumours) {
+      std::printf("[tumour  ] %-8s centroid (%.2f, %.2f, %.2f) mm, volume ratio %.3f, axis ratio %.3f (prone %.3f)",
+                  t.name.c_str(), t.centroid.x() * 1e3, t.centroid.y() * 1e3, t.centroid.z() * 1e3, t.volume_ratio,
+                  t.axis_ratio, t.prone_axis_ratio);
+      if (t.has_ground_truth)
+        std::printf(", centroid error %.3f mm (rigid only %.2f mm), Hausdorff %.2f mm", t.centroid_distance * 1e3,
+                    t.rigid_centroid_distance * 1e3, t.hausdorff * 1e3);
+      std::printf("\n");
+    }
+    const auto files = write_registration_outputs(out_dir, scene, model, r, prepare);
+    std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "
+                "(report.json, cross_section.png, registered.vtk, ...)\n",
+                r.seconds, scene.tetrahedralize_seconds, prepare, files.size(),
+                std::filesystem::absolute(out_dir).string().c_str());
+    if (!r.converged) {
+      std::fprintf(stderr, "btr_register: a step stopped without converging (see report.json); try the accurate preset\n");
+      return 4;
+    }
+    return 0;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "%sbtr_register: invalid input: %s\n", tty ? "\n" : "", e.what());
+    return 2;
+  } catch (const SolverError& e) {
+    std::fprintf(stderr, "%sbtr_register: numerical failure: %s\n", tty ? "\n" : "", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%sbtr_register: error: %s\n", tty ? "\n" : "", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,299 @@
+// The registration method (thesis Ch. 4) on small phantoms, with real assertions on the error.
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/icp_alignment.h"
+#include "breast_tumour_registration/core/index_io.h"
+#include "breast_tumour_registration/core/mesh_io.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/phantom_scene.h"
+#include "breast_tumour_registration/core/registration_report.h"
+#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/core/skinning_subspace.h"
+#include "test_util.h"
+
+using namespace btr;
+using btr::test::expect_throw_with;
+
+namespace {
+
+// One coarse phantom scene (2.2k tetrahedra, E = 3400 Pa) shared by the tests.
+const std::string& phantom_dir() {
+  static const std::string dir = [] {
+    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12").string();
+    std::filesystem::remove_all(d);
+    PhantomSceneOptions o;
+    o.phantom.tet.cell_size = 0.012;
+    o.phantom.surface_rings = 12;
+    write_phantom_scene(d, o);
+    return d;
+  }();
+  return dir;
+}
+
+// Copies the phantom scene with extra YAML lines appended (later keys override earlier ones).
+std::string scene_with(const std::string& extra, const std::string& name) {
+  const std::string path = phantom_dir() + "/" + name + ".yaml";
+  std::ifstream in(phantom_dir() + "/scene.yaml");
+  std::stringstream all;
+  all << in.rdbuf();
+  std::string text = all.str();
+  // Drop keys that `extra` redefines, so the YAML stays valid.
+  std::istringstream ex(extra);
+  std::string line;
+  while (std::getline(ex, line)) {
+    const auto colon = line.find(':');
+    if (colon == std::string::npos || line.empty() || line[0] == ' ') continue;
+    const std::string key = line.substr(0, colon + 1);
+    std::istringstream is(text);
+    std::string out, l;
+    bool skipping = false;
+    while (std::getline(is, l)) {
+      if (l.rfind(key, 0) == 0) { skipping = true; continue; }
+      if (skipping && !l.empty() && (l[0] == ' ' || l[0] == '-')) continue;
+      skipping = false;
+      out += l + "\n";
+    }
+    text = out;
+  }
+  std::ofstream(path) << text << extra << "\n";
+  return path;
+}
+
+RegistrationResult register_scene(const std::string& path, const std::string& preset = "balanced") {
+  const Scene s = load_scene(path);
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(s, warnings);
+  EXPECT_TRUE(warnings.empty());
+  return run_registration(s, m, preset_options(preset));
+}
+
+double worst_error(const RegistrationResult& r) {
+  double w = 0;
+  for (const auto& t : r.tumours) w = std::max(w, t.centroid_distance);
+  return w;
+}
+
+Rigid make_rigid(const Vec3& rot_deg, const Vec3& trans) {
+  Rigid T = Rigid::Identity();
+  T.linear() = (Eigen::AngleAxisd(rot_deg.z() * M_PI / 180, Vec3::UnitZ()) * Eigen::AngleAxisd(rot_deg.y() * M_PI / 180, Vec3::UnitY()) *
+                Eigen::AngleAxisd(rot_deg.x() * M_PI / 180, Vec3::UnitX())).toRotationMatrix();
+  T.translation() = trans;
+  return T;
+}
+
+}  // namespace
+
+TEST(Kabsch, RecoversAKnownRigidTransformAndRejectsBadInput) {
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  Points P(6, 3);
+  for (int i = 0; i < 18; ++i) P.data()[i] = u(rng);
+  const Rigid T = make_rigid(Vec3(10, -20, 35), Vec3(0.01, 0.02, -0.03));
+  const Rigid R = kabsch(P, transform_points(T, P));
+  EXPECT_LT((R.matrix() - T.matrix()).norm(), 1e-12);
+  expect_throw_with<InputError>([&] { kabsch(P.topRows(2), P.topRows(2)); }, "at least 3 pairs");
+  Points line(4, 3);
+  for (int i = 0; i < 4; ++i) line.row(i) << i * 0.01, 0, 0;
+  expect_throw_with<InputError>([&] { kabsch(line, line); }, "collinear");
+}
+
+TEST(Icp, RecoversAKnownTransformOnTheCurvedChestRing) {
+  const SurfaceMesh ring = make_chest_ring(0.0745, 0.0745, 0.04, 144);
+  const Rigid T = make_rigid(Vec3(4, -3, 5), Vec3(0.004, -0.003, 0.005));  // supine -> model
+  const Points supine = transform_points(T.inverse(), ring.V);
+  const IcpResult r = align_icp(supine, ring.V, Rigid::Identity(), IcpOptions{});
+  EXPECT_TRUE(r.accepted) << r.message;
+  const Rigid err = r.transform * T.inverse();
+  EXPECT_LT(rotation_angle(err) * 180 / M_PI, 0.05);
+  EXPECT_LT(err.translation().norm(), 5e-5);
+  EXPECT_LT(r.inlier_rms, 1e-4);
+}
+
+TEST(Icp, ChecksItsResultAndRejectsBadClouds) {
+  const SurfaceMesh ring = make_chest_ring(0.0745, 0.0745, 0.04, 144);
+  // A cloud far away: no overlap, not accepted, with a reason.
+  const Points far = transform_points(make_rigid(Vec3::Zero(), Vec3(0.5, 0, 0)), ring.V);
+  const IcpResult r = align_icp(far, ring.V, Rigid::Identity(), IcpOptions{});
+  EXPECT_FALSE(r.accepted);
+  EXPECT_FALSE(r.message.empty());
+  expect_throw_with<InputError>([&] { align_icp(Points(0, 3), ring.V, Rigid::Identity(), IcpOptions{}); }, "cloud is empty");
+  Points nan = ring.V;
+  nan(3, 2) = std::numeric_limits<double>::quiet_NaN();
+  expect_throw_with<InputError>([&] { align_icp(nan, ring.V, Rigid::Identity(), IcpOptions{}); }, "NaN");
+}
+
+TEST(SkinningSubspace, ReproducesAffineMapsAndKeepsTheChestWallFixed) {
+  const Scene s = load_scene(phantom_dir() + "/scene.yaml");
+  std::vector<bool> fixed(s.prone.V.rows(), false);
+  for (int v : s.chest_wall) fixed[v] = true;
+  SubspaceOptions o;
+  o.handles = 20;
+  const std::vector<int> seeds = {s.landmark_anchors[0].v[0], s.landmark_anchors[1].v[0]};
+  const SkinningSubspace S = build_skinning_subspace(s.prone.V, 8e-4, seeds, fixed, o);
+  ASSERT_EQ(S.handles.size(), 20u);
+  EXPECT_EQ(S.handles[0], seeds[0]);  // seeded with the landmarks, deterministic
+  EXPECT_EQ(build_skinning_subspace(s.prone.V, 8e-4, seeds, fixed, o).handles, S.handles);
+  // Every handle carries the same affine map: U q must be that map at every free vertex.
+  Mat3 B;
+  B << 0.1, -0.2, 0.05, 0.02, 0.1, 0.3, -0.1, 0.0, 0.2;
+  const Vec3 b(0.001, -0.002, 0.003);
+  const Vec3 centre = s.prone.V.colwise().mean().transpose();
+  Eigen::VectorXd q(S.basis.cols());
+  for (size_t j = 0; j < S.handles.size(); ++j)
+    for (int c = 0; c < 3; ++c) {
+      q[12 * j + c] = b[c];  // constant term
+      for (int a = 0; a < 3; ++a) q[12 * j + 3 * (a + 1) + c] = B(c, a) * S.radius;
+    }
+  const Eigen::VectorXd u = S.basis * q;
+  for (Eigen::Index i = 0; i < s.prone.V.rows(); ++i) {
+    const Vec3 ui = u.segment<3>(3 * i);
+    if (fixed[i]) {
+      EXPECT_EQ(ui.norm(), 0.0);
+    } else {
+      EXPECT_LT((ui - (B * (s.prone.V.row(i).transpose() - centre) + b)).norm(), 1e-12) << "vertex " << i;
+    }
+  }
+}
+
+TEST(Registration, LandmarkStepAloneHalvesTheTumourError) {
+  const RegistrationResult r = register_scene(scene_with("steps: [rigid, landmarks]", "landmarks_only"));
+  ASSERT_FALSE(r.steps.surface);
+  for (const auto& t : r.tumours) EXPECT_LT(t.centroid_distance, 0.5 * t.rigid_centroid_distance) << t.name;
+  EXPECT_LT(r.landmark_residual_max, 0.5e-3);
+}
+
+TEST(Registration, SurfaceStepAloneImprovesOnRigid) {
+  const RegistrationResult r = register_scene(scene_with("steps: [surface]", "surface_only"), "accurate");
+  ASSERT_FALSE(r.steps.landmarks);
+  for (const auto& t : r.tumours) EXPECT_LT(t.centroid_distance, 0.5 * t.rigid_centroid_distance) << t.name;
+  EXPECT_LT(r.skin_distance_mean, 0.1e-3);
+}
+
+TEST(Registration, FullMethodBringsEveryTumourWithinHalfAMillimetre) {
+  const RegistrationResult r = register_scene(phantom_dir() + "/scene.yaml");
+  ASSERT_EQ(r.tumours.size(), 5u);
+  EXPECT_TRUE(r.converged);
+  for (const auto& t : r.tumours) {
+    EXPECT_LT(t.centroid_distance, 0.5e-3) << t.name;
+    EXPECT_GT(t.rigid_centroid_distance, 1e-3) << t.name << ": the phantom should deform";
+    EXPECT_NEAR(t.volume_ratio, 1.0, 0.02);
+  }
+}
+
+class Misalignment : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(Misalignment, RigidAlignmentKeepsTheFullMethodWithinTwoMillimetres) {
+  const RegistrationResult r = register_scene(scene_with("misalignment: " + GetParam(), "mis" + std::to_string(std::hash<std::string>{}(GetParam()))));
+  EXPECT_TRUE(r.icp_used) << r.icp.message;
+  EXPECT_LT(worst_error(r), 2e-3);
+  EXPECT_LT(worst_error(r), 0.5e-3);  // in fact as good as without misalignment
+}
+
+INSTANTIATE_TEST_SUITE_P(Thesis525, Misalignment,
+                         ::testing::Values("{rotation_deg: [15, 0, 0]}", "{rotation_deg: [0, 15, 0]}", "{rotation_deg: [0, 0, 15]}",
+                                           "{translation_mm: [10, 0, 0]}", "{translation_mm: [0, 10, 0]}",
+                                           "{translation_mm: [0, 0, -10]}", "{rotation_deg: [15, 15, 15], translation_mm: [10, 10, 10]}"));
+
+TEST(Registration, WithoutTheRigidStepMisalignmentBreaksTheMethodAsInTheThesis) {
+  const RegistrationResult r = register_scene(scene_with("misalignment: {rotation_deg: [15, 0, 0]}\nsteps: [landmarks, surface]", "mis_norigid"));
+  EXPECT_GT(worst_error(r), 3e-3);
+}
+
+TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
+  const Scene full = load_scene(phantom_dir() + "/scene.yaml");
+  PlannedSteps p = plan_steps(full);
+  EXPECT_TRUE(p.rigid_landmarks && p.rigid_icp && p.landmarks && p.surface);
+  EXPECT_FALSE(p.gravity);
+  Scene lm = full;
+  lm.supine_surface.reset();
+  p = plan_steps(lm);
+  EXPECT_TRUE(p.landmarks && !p.surface);
+  Scene surf = full;
+  surf.landmark_anchors.clear();
+  surf.landmark_supine.resize(0, 3);
+  p = plan_steps(surf);
+  EXPECT_TRUE(p.surface && !p.landmarks && !p.rigid_landmarks && p.rigid_icp);
+  Scene bad = lm;
+  bad.steps = {"surface"};
+  expect_throw_with<InputError>([&] { plan_steps(bad); }, "'surface' needs the field 'supine.surface'");
+  Scene gravity = full;
+  gravity.steps = {"gravity", "surface"};
+  p = plan_steps(gravity);
+  EXPECT_TRUE(p.gravity && p.surface && !p.landmarks && !p.rigid_landmarks);
+}
+
+TEST(SceneErrors, NameTheFieldAtFault) {
+  const std::string d = btr::test::temp_dir();
+  btr::test::write_text(d + "/a.yaml", "units: mm\n");
+  expect_throw_with<InputError>([&] { load_scene(d + "/a.yaml"); }, "field 'prone'");
+  expect_throw_with<InputError>([&] { load_scene(d + "/missing.yaml"); }, "cannot open scene");
+  btr::test::write_text(d + "/b.yaml", "units: [\n");
+  expect_throw_with<InputError>([&] { load_scene(d + "/b.yaml"); }, "YAML syntax error");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("units: furlong", "bad_units")); }, "field 'units'");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("steps: [rigid, teleport]", "bad_step")); }, "unknown step 'teleport'");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("preset: turbo", "bad_preset")); }, "field 'preset'");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("material: {youngs_modulus: -5}", "bad_E")); }, "field 'material'");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("chest_wall: nowhere.txt", "bad_wall")); }, "field 'chest_wall'");
+  btr::test::write_text(phantom_dir() + "/bad_landmarks.csv", "prone_index,supine_index\n99999,1\n");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("landmarks: bad_landmarks.csv", "bad_lm")); }, "field 'landmarks'");
+}
+
+TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
+  // The prone model given as a surface: indices refer to the surface and must survive meshing.
+  const Scene tets = load_scene(phantom_dir() + "/scene.yaml");
+  const std::string d = phantom_dir();
+  SurfaceMesh skin;
+  std::vector<int> to_tet;
+  skin = boundary_surface(tets.prone, &to_tet);
+  write_surface(d + "/prone_skin_surface.obj", skin, LengthUnit::Millimetre);
+  std::vector<int> wall;
+  for (size_t i = 0; i < to_tet.size(); ++i)
+    if (std::find(tets.chest_wall.begin(), tets.chest_wall.end(), to_tet[i]) != tets.chest_wall.end()) wall.push_back(static_cast<int>(i));
+  write_index_list(d + "/chest_wall_surface.txt", wall);
+  std::vector<LandmarkPair> pairs;
+  for (Eigen::Index i = 0; i < tets.landmark_supine.rows(); ++i) {
+    LandmarkPair p;
+    p.prone_vertex = static_cast<int>(std::find(to_tet.begin(), to_tet.end(), tets.landmark_anchors[i].v[0]) - to_tet.begin());
+    p.supine_point = tets.landmark_supine.row(i).transpose();
+    pairs.push_back(p);
+  }
+  write_landmark_pairs(d + "/landmarks_surface.csv", pairs, LengthUnit::Millimetre);
+  const std::string path = scene_with(
+      "prone: {surface: prone_skin_surface.obj, cell_size_mm: 12}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
+      "from_surface");
+  const Scene s = load_scene(path);
+  EXPECT_TRUE(s.tetrahedralized);
+  for (int v : s.chest_wall) EXPECT_LT(std::abs(s.prone.V(v, 2)), 1e-6);
+  for (size_t i = 0; i < s.landmark_anchors.size(); ++i)
+    EXPECT_LT((s.landmark_anchors[i].position(s.prone.V) - tets.landmark_anchors[i].position(tets.prone.V)).norm(), 1.2e-3);
+  const RegistrationResult r = register_scene(path);
+  EXPECT_LT(worst_error(r), 0.5e-3);
+}
+
+TEST(Outputs, ReportAndPictureAreWritten) {
+  const Scene s = load_scene(phantom_dir() + "/scene.yaml");
+  std::vector<std::string> w;
+  const RegistrationModel m = prepare_model(s, w);
+  const RegistrationResult r = run_registration(s, m, preset_options("fast"));
+  const std::string d = btr::test::temp_dir();
+  const auto files = write_registration_outputs(d, s, m, r, 0.1);
+  EXPECT_TRUE(std::filesystem::exists(d + "/report.json"));
+  EXPECT_GT(std::filesystem::file_size(d + "/cross_section.png"), 1000u);
+  std::ifstream png(d + "/cross_section.png", std::ios::binary);
+  char sig[8];
+  png.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+  const std::string json = registration_report_json(s, m, r, 0.1);
+  EXPECT_NE(json.find("\"centroid_distance_mm\""), std::string::npos);
+  EXPECT_NE(json.find("\"rigid_transform_supine_to_model\""), std::string::npos);
+  const TetMesh back = read_tet_mesh(d + "/registered.vtk", LengthUnit::Millimetre);
+  EXPECT_EQ(back.T.rows(), m.rest.T.rows());
+}
+
+TEST(Presets, UnknownPresetIsAnError) {
+  expect_throw_with<InputError>([] { preset_options("ludicrous"); }, "unknown preset");
+}
