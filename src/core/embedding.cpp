@@ -127,6 +127,36 @@ Embedding embed_points(const TetMesh& mesh, const Points& P, OutsidePolicy polic
   return e;
 }
 
+namespace {
+// Winding number of a closed surface around p (robust to how the surface is sampled).
+bool inside_closed(const SurfaceMesh& s, const Vec3& p) {
+  double w = 0;
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
+    const Vec3 a = Vec3(s.V.row(s.F(f, 0))) - p, b = Vec3(s.V.row(s.F(f, 1))) - p, c = Vec3(s.V.row(s.F(f, 2))) - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    w += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+  }
+  return w / (4 * M_PI) > 0.5;
+}
+}  // namespace
+
+std::vector<int> tetrahedra_inside(const TetMesh& mesh, const std::vector<const SurfaceMesh*>& surfaces) {
+  std::vector<int> out;
+  for (Eigen::Index e = 0; e < mesh.T.rows(); ++e) {
+    Vec3 c = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) c += mesh.V.row(mesh.T(e, k)).transpose() / 4.0;
+    for (const SurfaceMesh* s : surfaces) {
+      const Vec3 lo = s->V.colwise().minCoeff().transpose(), hi = s->V.colwise().maxCoeff().transpose();
+      if ((c.array() < lo.array()).any() || (c.array() > hi.array()).any()) continue;
+      if (inside_closed(*s, c)) {
+        out.push_back(static_cast<int>(e));
+        break;
+      }
+    }
+  }
+  return out;
+}
+
 Points apply_embedding(const Embedding& e, const Tetrahedra& T, const Points& x) {
   Points out(e.tet.size(), 3);
   for (Eigen::Index i = 0; i < e.tet.size(); ++i) {

@@ -17,7 +17,17 @@ GravityResult solve_gravity(const GravityProblem& pb, const NewtonOptions& optio
     fixed[v] = true;
   }
   TotalEnergy energy;
-  energy.add(std::make_shared<ElasticEnergy>(rest, std::vector<StableNeoHookean>{StableNeoHookean(pb.youngs_modulus, pb.poisson_ratio)}));
+  std::vector<StableNeoHookean> materials{StableNeoHookean(pb.youngs_modulus, pb.poisson_ratio)};
+  std::vector<int> material_of;
+  if (!pb.inclusion.empty()) {
+    materials.push_back(StableNeoHookean(pb.inclusion_youngs_modulus, pb.poisson_ratio));
+    material_of.assign(rest.T.rows(), 0);
+    for (int t : pb.inclusion) {
+      if (t < 0 || t >= rest.T.rows()) throw InputError("solve_gravity: inclusion tetrahedron out of range");
+      material_of[t] = 1;
+    }
+  }
+  energy.add(std::make_shared<ElasticEnergy>(rest, materials, material_of));
   auto gravity = std::make_shared<GravityEnergy>(rest, pb.density, pb.gravity);
   energy.add(gravity);
   auto assembler = std::make_shared<HessianAssembler>(static_cast<int>(rest.V.rows()), rest.T, fixed);

@@ -56,23 +56,29 @@ IcpResult align_icp(const Points& source, const Points& target, const Rigid& ini
   if (!(opt.max_correspondence_distance > 0) || opt.max_iterations < 1)
     throw InputError("ICP: max_correspondence_distance must be positive and max_iterations >= 1");
   const Cloud::Ptr src = to_cloud(source, opt, "source"), tgt = to_cloud(target, opt, "target");
-  pcl::IterativeClosestPointWithNormals<pcl::PointNormal, pcl::PointNormal> icp;
-  icp.setInputSource(src);
-  icp.setInputTarget(tgt);
-  icp.setMaxCorrespondenceDistance(opt.max_correspondence_distance);
-  icp.setMaximumIterations(opt.max_iterations);
-  icp.setTransformationEpsilon(opt.transformation_epsilon);
-  icp.setEuclideanFitnessEpsilon(1e-14);
-  pcl::registration::CorrespondenceRejectorMedianDistance::Ptr rej(new pcl::registration::CorrespondenceRejectorMedianDistance);
-  rej->setMedianFactor(opt.median_factor);
-  icp.addCorrespondenceRejector(rej);
-  Cloud aligned;
-  icp.align(aligned, initial.matrix().cast<float>());
-
   IcpResult r;
-  r.converged = icp.hasConverged();
-  r.iterations = icp.nr_iterations_;
-  r.transform.matrix() = icp.getFinalTransformation().cast<double>();
+  Eigen::Matrix4f guess = initial.matrix().cast<float>();
+  // Coarse pass (wide radius, captures large offsets), then the fine pass.
+  for (const double radius : {opt.coarse_correspondence_distance, opt.max_correspondence_distance}) {
+    if (radius <= 0) continue;
+    pcl::IterativeClosestPointWithNormals<pcl::PointNormal, pcl::PointNormal> icp;
+    icp.setInputSource(src);
+    icp.setInputTarget(tgt);
+    icp.setMaxCorrespondenceDistance(radius);
+    icp.setMaximumIterations(opt.max_iterations);
+    icp.setTransformationEpsilon(opt.transformation_epsilon);
+    icp.setEuclideanFitnessEpsilon(1e-14);
+    pcl::registration::CorrespondenceRejectorMedianDistance::Ptr rej(new pcl::registration::CorrespondenceRejectorMedianDistance);
+    rej->setMedianFactor(opt.median_factor);
+    icp.addCorrespondenceRejector(rej);
+    Cloud aligned;
+    icp.align(aligned, guess);
+    r.converged = icp.hasConverged();
+    r.iterations += icp.nr_iterations_;
+    if (!r.converged) break;
+    guess = icp.getFinalTransformation();
+  }
+  r.transform.matrix() = guess.cast<double>();
   // Re-orthonormalize the float rotation.
   Eigen::JacobiSVD<Mat3> svd(r.transform.linear(), Eigen::ComputeFullU | Eigen::ComputeFullV);
   r.transform.linear() = svd.matrixU() * svd.matrixV().transpose();

@@ -36,6 +36,12 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
     pb.poisson_ratio = opt.poisson_ratio;
     pb.density = opt.density;
     pb.gravity = g;
+    if (opt.tumour_youngs_modulus > 0) {
+      std::vector<const SurfaceMesh*> tumours;
+      for (const auto& [name, t] : model.tumours) tumours.push_back(&t);
+      pb.inclusion = tetrahedra_inside(model.rest, tumours);
+      pb.inclusion_youngs_modulus = opt.tumour_youngs_modulus;
+    }
     NewtonOptions newton;
     if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
     GravityResult r = solve_gravity(pb, newton);
@@ -114,6 +120,7 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   scene["generator"]["youngs_modulus"] = opt.youngs_modulus;
   scene["generator"]["poisson_ratio"] = opt.poisson_ratio;
   scene["generator"]["density"] = opt.density;
+  scene["generator"]["tumour_youngs_modulus"] = opt.tumour_youngs_modulus;
   scene["generator"]["cell_size_mm"] = opt.phantom.tet.cell_size * 1e3;
   scene["generator"]["tetrahedra"] = sum.tetrahedra;
   YAML::Emitter y;

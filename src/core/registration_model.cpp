@@ -47,36 +47,16 @@ int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceM
   return outside;
 }
 
-namespace {
-// Inside test by the winding number of a closed surface (robust to its sampling).
-bool inside(const SurfaceMesh& s, const Vec3& p) {
-  double w = 0;
-  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
-    const Vec3 a = Vec3(s.V.row(s.F(f, 0))) - p, b = Vec3(s.V.row(s.F(f, 1))) - p, c = Vec3(s.V.row(s.F(f, 2))) - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    w += 2 * std::atan2(a.dot(b.cross(c)), la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
-  }
-  return w / (4 * M_PI) > 0.5;
-}
-}  // namespace
 
 void stiffen_tumours(RegistrationModel& model, double E) {
   model.materials.erase(model.materials.begin() + 1, model.materials.end());
   model.materials.push_back(StableNeoHookean(E, model.material.poisson_ratio));
   std::fill(model.material_of.begin(), model.material_of.end(), 0);
-  model.stiff_tetrahedra = 0;
-  for (const auto& t : model.tumours) {
-    const Vec3 lo = t.prone.V.colwise().minCoeff().transpose(), hi = t.prone.V.colwise().maxCoeff().transpose();
-    for (Eigen::Index e = 0; e < model.rest.T.rows(); ++e) {
-      Vec3 c = Vec3::Zero();
-      for (int k = 0; k < 4; ++k) c += model.rest.V.row(model.rest.T(e, k)).transpose() / 4.0;
-      if ((c.array() < lo.array()).any() || (c.array() > hi.array()).any()) continue;
-      if (model.material_of[e] == 0 && inside(t.prone, c)) {
-        model.material_of[e] = 1;
-        ++model.stiff_tetrahedra;
-      }
-    }
-  }
+  std::vector<const SurfaceMesh*> surfaces;
+  for (const auto& t : model.tumours) surfaces.push_back(&t.prone);
+  const std::vector<int> inside = tetrahedra_inside(model.rest, surfaces);
+  for (int e : inside) model.material_of[e] = 1;
+  model.stiff_tetrahedra = static_cast<long>(inside.size());
 }
 
 }  // namespace btr

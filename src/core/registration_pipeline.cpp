@@ -123,16 +123,33 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     T = kabsch(scene.landmark_supine, prone_lm);
   }
   if (r.steps.rigid_icp) {
-    r.icp = align_icp(scene.supine_rigid->V, scene.prone_rigid->V, T, opt.icp);
-    const Rigid delta = r.icp.transform * T.inverse();
-    if (r.icp.accepted && rotation_angle(delta) < 45.0 * M_PI / 180.0 && delta.translation().norm() < 0.05) {
+    // The rigid regions decide: landmarks sit on deforming skin, so their Kabsch fit absorbs
+    // part of the breast's own motion (tens of millimetres for soft tissue). ICP starts from
+    // the landmark fit, the identity and the centroid-matched regions; the accepted result
+    // with the lowest inlier RMS wins.
+    std::vector<Rigid> starts = {T};
+    if (r.steps.rigid_landmarks) starts.push_back(Rigid::Identity());
+    Rigid centred = Rigid::Identity();
+    centred.translation() = (scene.prone_rigid->V.colwise().mean() - scene.supine_rigid->V.colwise().mean()).transpose();
+    starts.push_back(centred);
+    bool have = false;
+    for (const Rigid& s : starts) {
+      const IcpResult icp = align_icp(scene.supine_rigid->V, scene.prone_rigid->V, s, opt.icp);
+      if (!have || (icp.accepted && (!r.icp.accepted || icp.inlier_rms < r.icp.inlier_rms))) {
+        r.icp = icp;
+        have = true;
+      }
+    }
+    if (r.icp.accepted) {
       T = r.icp.transform;
       r.icp_used = true;
     } else {
-      r.warnings.push_back("rigid alignment: " + r.icp.message +
-                           (r.icp.accepted ? " but it moved too far from the initial guess" : "") +
-                           "; keeping the " + (r.steps.rigid_landmarks ? "landmark" : "identity") + " alignment");
+      r.warnings.push_back("rigid alignment: " + r.icp.message + " from every initial guess; keeping the " +
+                           (r.steps.rigid_landmarks ? "landmark" : "identity") + " alignment");
     }
+  } else if (r.steps.rigid_landmarks) {
+    r.warnings.push_back("rigid alignment from landmarks only: landmarks on deforming skin bias it; give the rigid "
+                         "regions (chest_ring and supine.chest_ring) for ICP");
   }
   r.supine_to_model = T;
   r.rigid_seconds = since(t0);

@@ -66,6 +66,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceMesh& supin
     if (callback) nopt.callback = [&](const IterationInfo& it) {
       IterationInfo shifted = it;
       shifted.iteration += offset;
+      shifted.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       return callback("surface", shifted);
     };
     const NewtonResult r = solver.solve(energy, x, nopt);

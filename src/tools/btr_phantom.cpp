@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   double E = 3400, nu = 0.49, rho = 1000, cell_mm = 8.0, tumour_mm = 10.0, ratio = 2.0;
   std::string units = "mm", landmark_set = "C+O";
   bool quiet = false;
+  double tumour_E = 0;
   app.add_option("-o,--out", out_dir, "output folder (created)")->capture_default_str();
   app.add_option("-E,--youngs-modulus", E, "Young's modulus used to generate prone and supine [Pa]")->capture_default_str();
   app.add_option("--poisson-ratio", nu, "Poisson's ratio, in [0, 0.5)")->capture_default_str();
@@ -33,6 +34,8 @@ int main(int argc, char** argv) {
   app.add_option("--tumour-radius", tumour_mm, "tumour sphere radius [mm]")->capture_default_str();
   app.add_option("--units", units, "length unit of the written files: mm or m")->capture_default_str();
   app.add_option("--landmarks", landmark_set, "landmark set: C+O, O+Oa+I, O+I, O+Oa, Oa+I, or names like C,O1,O2")
+      ->capture_default_str();
+  app.add_option("--tumour-youngs-modulus", tumour_E, "generate with stiff tumours of this Young's modulus [Pa] (0: homogeneous)")
       ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no per-iteration progress");
   CLI11_PARSE(app, argc, argv);
@@ -48,6 +51,7 @@ int main(int argc, char** argv) {
     o.phantom.tet.cell_size = cell_mm * 1e-3;
     o.phantom.tet.radius_edge_ratio = ratio;
     o.phantom.tumour_radius = tumour_mm * 1e-3;
+    o.tumour_youngs_modulus = tumour_E;
     std::printf("[phantom] tetrahedralizing the half ellipsoid (cell size %.2f mm) and solving prone and supine...\n", cell_mm);
     const auto progress = [&](const std::string& name, const IterationInfo& it) {
       if (!quiet)

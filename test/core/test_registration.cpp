@@ -35,9 +35,9 @@ const std::string& phantom_dir() {
 }
 
 // Copies the phantom scene with extra YAML lines appended (later keys override earlier ones).
-std::string scene_with(const std::string& extra, const std::string& name) {
-  const std::string path = phantom_dir() + "/" + name + ".yaml";
-  std::ifstream in(phantom_dir() + "/scene.yaml");
+std::string scene_with(const std::string& extra, const std::string& name, const std::string& base = phantom_dir()) {
+  const std::string path = base + "/" + name + ".yaml";
+  std::ifstream in(base + "/scene.yaml");
   std::stringstream all;
   all << in.rdbuf();
   std::string text = all.str();
@@ -296,4 +296,53 @@ TEST(Outputs, ReportAndPictureAreWritten) {
 
 TEST(Presets, UnknownPresetIsAnError) {
   expect_throw_with<InputError>([] { preset_options("ludicrous"); }, "unknown preset");
+}
+
+namespace {
+// A soft phantom (E = 400 Pa) with stiff tumours (4 kPa) in the ground truth: large
+// deformation (about 14 mm tumour motion), where landmark-only rigid fits are biased.
+const std::string& soft_phantom_dir() {
+  static const std::string dir = [] {
+    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom_soft").string();
+    std::filesystem::remove_all(d);
+    PhantomSceneOptions o;
+    o.phantom.tet.cell_size = 0.009;
+    o.phantom.surface_rings = 16;
+    o.youngs_modulus = 400;
+    o.tumour_youngs_modulus = 4000;
+    write_phantom_scene(d, o);
+    return d;
+  }();
+  return dir;
+}
+}  // namespace
+
+TEST(RigidAlignment, RigidRegionsOverruleLandmarksOnDeformingSkin) {
+  const Scene s = load_scene(soft_phantom_dir() + "/scene.yaml");
+  Points prone_lm(s.landmark_anchors.size(), 3);
+  for (size_t i = 0; i < s.landmark_anchors.size(); ++i) prone_lm.row(i) = s.landmark_anchors[i].position(s.prone.V).transpose();
+  const Rigid landmark_fit = kabsch(s.landmark_supine, prone_lm);
+  EXPECT_GT(landmark_fit.translation().norm(), 0.01) << "the landmarks' Kabsch fit absorbs the sag";
+  const RegistrationResult r = register_scene(soft_phantom_dir() + "/scene.yaml");
+  EXPECT_TRUE(r.icp_used);
+  EXPECT_LT(r.supine_to_model.translation().norm(), 1e-4);  // truth: identity
+  EXPECT_LT(rotation_angle(r.supine_to_model), 1e-3);
+  for (const auto& t : r.tumours) {
+    EXPECT_GT(t.rigid_centroid_distance, 0.01) << t.name;
+    EXPECT_LT(t.centroid_distance, 0.2 * t.rigid_centroid_distance) << t.name;  // a biased rigid fit gives ~1x
+  }
+}
+
+TEST(StiffTumour, KeepsTheTumourShapeCloserToTheTruth) {
+  auto mean_axis_gap = [](const RegistrationResult& r) {
+    double gap = 0;
+    for (const auto& t : r.tumours) gap += std::abs(t.axis_ratio - t.truth_axis_ratio) / r.tumours.size();
+    return gap;
+  };
+  const RegistrationResult homogeneous = register_scene(soft_phantom_dir() + "/scene.yaml");
+  const RegistrationResult stiff =
+      register_scene(scene_with("tumour_material: {youngs_modulus: 17000}", "stiff_tumour", soft_phantom_dir()));
+  EXPECT_LT(mean_axis_gap(stiff), 0.5 * mean_axis_gap(homogeneous));
+  for (size_t i = 0; i < stiff.tumours.size(); ++i)
+    EXPECT_GT(stiff.tumours[i].axis_ratio, homogeneous.tumours[i].axis_ratio) << "homogeneous material flattens more";
 }

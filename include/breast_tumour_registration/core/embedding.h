@@ -29,6 +29,10 @@ struct Embedding {
 Embedding embed_points(const TetMesh& mesh, const Points& P, OutsidePolicy policy = OutsidePolicy::NearestTetrahedron,
                        double tolerance = 1e-9);
 
+/// Tetrahedra of `mesh` whose centroid lies inside any of the closed `surfaces` (winding
+/// number), e.g. the elements of a tumour that get their own material.
+std::vector<int> tetrahedra_inside(const TetMesh& mesh, const std::vector<const SurfaceMesh*>& surfaces);
+
 /// Positions of the embedded points for deformed vertex positions x (#V by 3).
 Points apply_embedding(const Embedding& e, const Tetrahedra& T, const Points& x);
 

@@ -17,6 +17,8 @@ struct GravityProblem {
   double poisson_ratio = 0.49;
   double density = 1000;              ///< [kg/m^3]
   Vec3 gravity = Vec3(0, 0, -9.81);   ///< [m/s^2]
+  std::vector<int> inclusion;         ///< tetrahedra with their own Young's modulus (e.g. a stiff tumour)
+  double inclusion_youngs_modulus = 0;  ///< [Pa], same Poisson's ratio
 };
 
 struct GravityResult {

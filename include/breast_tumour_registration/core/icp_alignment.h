@@ -12,7 +12,9 @@ namespace btr {
 
 struct IcpOptions {
   int max_iterations = 40;
-  double max_correspondence_distance = 0.01;  ///< [m]
+  double max_correspondence_distance = 0.01;  ///< [m] of the final (fine) pass
+  /// [m] a first pass with this wider radius captures larger initial offsets; <= 0: none.
+  double coarse_correspondence_distance = 0.05;
   double voxel_size = 0.003;                  ///< [m] downsampling; <= 0: none
   int normal_neighbours = 12;
   double transformation_epsilon = 1e-10;

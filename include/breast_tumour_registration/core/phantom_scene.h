@@ -19,6 +19,9 @@ struct PhantomSceneOptions {
   double density = 1000;
   LengthUnit units = LengthUnit::Millimetre;
   std::string landmark_set = "C+O";
+  /// > 0: the tumours' elements get this Young's modulus when generating prone and supine
+  /// (real tumours are stiffer than the breast, thesis Ch. 6); 0: homogeneous.
+  double tumour_youngs_modulus = 0;
 };
 
 struct PhantomSceneSummary {
