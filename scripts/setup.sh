@@ -12,6 +12,8 @@ DEB_PACKAGES=(
   ros-core-dev libtf2-ros-dev libtf2-eigen-dev libpcl-conversions-dev libpcl-dev
   libcgal-dev libsuitesparse-dev libeigen3-dev python3-rostest librostest-dev
   python3-rosbag librosbag-dev ros-message-generation libstd-srvs-dev python3-roslaunch
+  libsensor-msgs-dev libshape-msgs-dev libvisualization-msgs-dev libgeometry-msgs-dev libdiagnostic-msgs-dev
+  libtf2-msgs-dev
   libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
   python3-matplotlib python3-numpy zlib1g-dev cmake g++ make time
 )
@@ -29,9 +31,19 @@ else
   echo "[setup] all Debian packages present"
 fi
 
-# catkin wants <ws>/src/<package>; the repository root is the package.
+# catkin wants <ws>/src/<package>; the repository root is the package. The package folder
+# links every top-level entry of the repository except build/ and out/: a single link to
+# the root would contain itself, and roslaunch's file search would recurse forever.
 mkdir -p "$WS/src"
-ln -sfn ../../.. "$WS/src/$PKG"
+[ -L "$WS/src/$PKG" ] && rm "$WS/src/$PKG"
+mkdir -p "$WS/src/$PKG"
+for entry in "$REPO_ROOT"/* "$REPO_ROOT"/.ci; do
+  name="$(basename "$entry")"
+  case "$name" in build|out) continue ;; esac
+  ln -sfn "$entry" "$WS/src/$PKG/$name"
+done
+# Drop links to entries that no longer exist.
+find "$WS/src/$PKG" -maxdepth 1 -xtype l -delete
 
 # The pyenv python3 on PATH lacks catkin_pkg: always use Debian's interpreter.
 export PATH="/usr/bin:$PATH"

@@ -116,6 +116,10 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   // 1. Rigid alignment: Kabsch on the landmarks, then ICP on the rigid regions.
   auto t0 = Clock::now();
   Rigid T = Rigid::Identity();
+  if (opt.known_supine_to_model) {
+    T = *opt.known_supine_to_model;
+    r.steps.rigid_landmarks = r.steps.rigid_icp = false;
+  }
   if (r.steps.rigid_landmarks) {
     Points prone_lm(scene.landmark_anchors.size(), 3);
     for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)

@@ -3,6 +3,7 @@
 // the tumours in the supine frame with the figures of merit.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ struct RegistrationOptions {
   LandmarkStepOptions landmark;
   SurfaceStepOptions surface;
   NewtonOptions gravity;  ///< gravity pre-step
+  /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
+  /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
+  std::optional<Rigid> known_supine_to_model;
 };
 
 /// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the

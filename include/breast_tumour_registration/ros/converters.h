@@ -1,0 +1,43 @@
+// Small static converters between ROS messages and the core library's types. No state,
+// no node handle: unit-tested without a master.
+#pragma once
+
+#include <geometry_msgs/Point.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <shape_msgs/Mesh.h>
+#include <visualization_msgs/Marker.h>
+
+#include <string>
+
+#include "breast_tumour_registration/core/rigid_transform.h"
+#include "breast_tumour_registration/core/types.h"
+
+namespace btr::ros_conv {
+
+struct CloudPoints {
+  Points points;        ///< one row per pixel when organized (NaN kept), else finite points only
+  int width = 0, height = 0;
+  bool organized = false;
+  long finite = 0;      ///< number of finite points
+};
+
+/// Reads x, y, z (FLOAT32 or FLOAT64) of a PointCloud2. `keep_nan` keeps the organized
+/// layout (NaN rows); otherwise NaN and infinite points are dropped. Throws InputError for
+/// a cloud without x, y, z fields or with inconsistent sizes.
+CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan);
+
+/// An organized XYZ FLOAT32 PointCloud2 (NaN rows stay NaN) in `frame_id`.
+sensor_msgs::PointCloud2 to_cloud(const Points& P, int width, int height, const std::string& frame_id);
+
+shape_msgs::Mesh to_mesh(const SurfaceMesh& s);
+SurfaceMesh from_mesh(const shape_msgs::Mesh& m);
+
+/// A TRIANGLE_LIST marker of the surface.
+visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& frame_id, const std::string& ns, int id,
+                                     float r, float g, float b, float a);
+
+geometry_msgs::Transform to_transform(const Rigid& T);
+Rigid from_transform(const geometry_msgs::Transform& t);
+
+}  // namespace btr::ros_conv

@@ -1,0 +1,87 @@
+// The ROS node: a thin adapter over the core library. It loads and caches a scene at
+// start-up, tracks the prone model's rigid region in the depth cloud with ICP (tf2
+// broadcast), runs the FEM registration in a service on its own threads, and publishes
+// the tumour mesh, markers, result and status. Bad input is logged and answered with
+// success: false; the node keeps running.
+#pragma once
+
+#include <diagnostic_msgs/DiagnosticStatus.h>
+#include <ros/callback_queue.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/transform_broadcaster.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "breast_tumour_registration/Register.h"
+#include "breast_tumour_registration/core/icp_alignment.h"
+#include "breast_tumour_registration/core/registration_pipeline.h"
+
+namespace btr {
+
+struct NodeParameters {
+  std::string scene;                      ///< ~scene: scene file (YAML)
+  std::string working_frame = "world";    ///< ~working_frame: frame of the results
+  std::string model_frame = "breast_model";  ///< ~model_frame: the prone model's frame (tf child)
+  std::string preset = "balanced";        ///< ~preset
+  double voxel_size = 0.004;              ///< ~voxel_size [m] for tracking ICP
+  Vec3 roi_min = Vec3::Constant(-1e9), roi_max = Vec3::Constant(1e9);  ///< ~roi_min/~roi_max [m], working frame
+  int icp_every_n = 1;                    ///< ~icp_every_n: track on every n-th cloud
+  int icp_max_iterations = 10;            ///< ~icp_max_iterations per cloud (warm-started)
+  double icp_max_correspondence = 0.01;   ///< ~icp_max_correspondence [m]
+  Rigid initial_model_pose = Rigid::Identity();  ///< ~initial_model_pose [x y z roll pitch yaw], working frame
+  double max_depth_edge = 0.01;           ///< ~max_depth_edge [m]: no surface across depth jumps
+  bool use_landmarks = true;              ///< ~use_landmarks with the live cloud
+};
+
+/// Reads the parameters with defaults; throws InputError naming a parameter out of range.
+NodeParameters read_node_parameters(const ros::NodeHandle& pnh);
+
+class RegistrationNode {
+ public:
+  RegistrationNode(ros::NodeHandle nh, ros::NodeHandle pnh);
+  ~RegistrationNode();
+
+ private:
+  void load_scene();
+  void on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg);
+  bool on_register(breast_tumour_registration::Register::Request& req,
+                   breast_tumour_registration::Register::Response& res);
+  void publish_status(uint8_t level, const std::string& message);
+  void publish_result(const RegistrationResult& r, const RegistrationModel& model, const std::string& preset,
+                      breast_tumour_registration::RegistrationResult& out);
+
+  ros::NodeHandle nh_, pnh_;
+  NodeParameters params_;
+  // Cached model (built once at start-up).
+  std::optional<Scene> scene_;
+  std::optional<RegistrationModel> model_;
+  std::string scene_error_;
+  // Latest cloud (working frame, organized with NaN) and the tracked rigid alignment.
+  std::mutex state_mutex_;
+  Points latest_cloud_;
+  int latest_width_ = 0, latest_height_ = 0;
+  bool have_cloud_ = false;
+  ros::Time latest_stamp_;
+  std::optional<Rigid> model_to_working_;
+  Rigid icp_guess_;
+  long clouds_seen_ = 0;
+  // Registration runs one at a time; a second request gets an answer, not a deadlock.
+  std::mutex registration_mutex_;
+
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  tf2_ros::TransformBroadcaster tf_broadcaster_;
+  ros::Subscriber cloud_sub_;
+  ros::CallbackQueue service_queue_;
+  std::unique_ptr<ros::AsyncSpinner> service_spinner_;
+  ros::ServiceServer register_srv_;
+  ros::Publisher mesh_pub_, marker_pub_, breast_marker_pub_, result_pub_, status_pub_;
+};
+
+}  // namespace btr

@@ -1,0 +1,151 @@
+#include "breast_tumour_registration/ros/converters.h"
+
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "breast_tumour_registration/core/errors.h"
+
+namespace btr::ros_conv {
+
+CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan) {
+  const sensor_msgs::PointField* f[3] = {nullptr, nullptr, nullptr};
+  for (const auto& field : msg.fields) {
+    if (field.name == "x") f[0] = &field;
+    if (field.name == "y") f[1] = &field;
+    if (field.name == "z") f[2] = &field;
+  }
+  if (!f[0] || !f[1] || !f[2]) throw InputError("point cloud has no x, y, z fields");
+  for (const auto* p : f)
+    if (p->datatype != sensor_msgs::PointField::FLOAT32 && p->datatype != sensor_msgs::PointField::FLOAT64)
+      throw InputError("point cloud field '" + p->name + "' is not FLOAT32 or FLOAT64");
+  const size_t n = static_cast<size_t>(msg.width) * msg.height;
+  if (msg.point_step == 0 || msg.data.size() < n * msg.point_step || msg.row_step < msg.width * msg.point_step)
+    throw InputError("point cloud data size does not match width x height x point_step");
+  CloudPoints out;
+  out.width = static_cast<int>(msg.width);
+  out.height = static_cast<int>(msg.height);
+  out.organized = msg.height > 1;
+  const bool organized_keep = keep_nan && out.organized;
+  out.points.resize(static_cast<Eigen::Index>(n), 3);
+  Eigen::Index k = 0;
+  for (uint32_t r = 0; r < msg.height; ++r)
+    for (uint32_t c = 0; c < msg.width; ++c) {
+      const uint8_t* base = msg.data.data() + r * msg.row_step + c * msg.point_step;
+      double v[3];
+      for (int i = 0; i < 3; ++i) {
+        if (f[i]->datatype == sensor_msgs::PointField::FLOAT32) {
+          float x;
+          std::memcpy(&x, base + f[i]->offset, 4);
+          v[i] = x;
+        } else {
+          std::memcpy(&v[i], base + f[i]->offset, 8);
+        }
+      }
+      const bool finite = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+      out.finite += finite;
+      if (!finite && !organized_keep) continue;
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      out.points.row(k++) << (finite ? v[0] : nan), (finite ? v[1] : nan), (finite ? v[2] : nan);
+    }
+  out.points.conservativeResize(k, 3);
+  if (!organized_keep) out.organized = false;
+  return out;
+}
+
+sensor_msgs::PointCloud2 to_cloud(const Points& P, int width, int height, const std::string& frame_id) {
+  sensor_msgs::PointCloud2 msg;
+  msg.header.frame_id = frame_id;
+  sensor_msgs::PointCloud2Modifier mod(msg);
+  mod.setPointCloud2FieldsByString(1, "xyz");
+  msg.height = height;
+  msg.width = width;
+  mod.resize(static_cast<size_t>(width) * height);
+  msg.height = height;
+  msg.width = width;
+  msg.row_step = msg.point_step * width;
+  msg.is_dense = false;
+  sensor_msgs::PointCloud2Iterator<float> x(msg, "x"), y(msg, "y"), z(msg, "z");
+  for (Eigen::Index i = 0; i < P.rows(); ++i, ++x, ++y, ++z) {
+    *x = static_cast<float>(P(i, 0));
+    *y = static_cast<float>(P(i, 1));
+    *z = static_cast<float>(P(i, 2));
+  }
+  return msg;
+}
+
+shape_msgs::Mesh to_mesh(const SurfaceMesh& s) {
+  shape_msgs::Mesh m;
+  m.vertices.resize(s.V.rows());
+  for (Eigen::Index i = 0; i < s.V.rows(); ++i) {
+    m.vertices[i].x = s.V(i, 0);
+    m.vertices[i].y = s.V(i, 1);
+    m.vertices[i].z = s.V(i, 2);
+  }
+  m.triangles.resize(s.F.rows());
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) m.triangles[f].vertex_indices[k] = static_cast<uint32_t>(s.F(f, k));
+  return m;
+}
+
+SurfaceMesh from_mesh(const shape_msgs::Mesh& m) {
+  SurfaceMesh s;
+  s.V.resize(m.vertices.size(), 3);
+  for (size_t i = 0; i < m.vertices.size(); ++i) s.V.row(i) << m.vertices[i].x, m.vertices[i].y, m.vertices[i].z;
+  s.F.resize(m.triangles.size(), 3);
+  for (size_t f = 0; f < m.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      if (m.triangles[f].vertex_indices[k] >= m.vertices.size()) throw InputError("mesh triangle index out of range");
+      s.F(f, k) = static_cast<int>(m.triangles[f].vertex_indices[k]);
+    }
+  return s;
+}
+
+visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& frame_id, const std::string& ns, int id,
+                                     float r, float g, float b, float a) {
+  visualization_msgs::Marker mk;
+  mk.header.frame_id = frame_id;
+  mk.ns = ns;
+  mk.id = id;
+  mk.type = visualization_msgs::Marker::TRIANGLE_LIST;
+  mk.action = visualization_msgs::Marker::ADD;
+  mk.pose.orientation.w = 1.0;
+  mk.scale.x = mk.scale.y = mk.scale.z = 1.0;
+  mk.color.r = r;
+  mk.color.g = g;
+  mk.color.b = b;
+  mk.color.a = a;
+  mk.points.reserve(3 * s.F.rows());
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      geometry_msgs::Point p;
+      p.x = s.V(s.F(f, k), 0);
+      p.y = s.V(s.F(f, k), 1);
+      p.z = s.V(s.F(f, k), 2);
+      mk.points.push_back(p);
+    }
+  return mk;
+}
+
+geometry_msgs::Transform to_transform(const Rigid& T) {
+  geometry_msgs::Transform t;
+  t.translation.x = T.translation().x();
+  t.translation.y = T.translation().y();
+  t.translation.z = T.translation().z();
+  const Eigen::Quaterniond q(T.rotation());
+  t.rotation.x = q.x();
+  t.rotation.y = q.y();
+  t.rotation.z = q.z();
+  t.rotation.w = q.w();
+  return t;
+}
+
+Rigid from_transform(const geometry_msgs::Transform& t) {
+  Rigid T = Rigid::Identity();
+  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized().toRotationMatrix();
+  T.translation() = Vec3(t.translation.x, t.translation.y, t.translation.z);
+  return T;
+}
+
+}  // namespace btr::ros_conv

@@ -1,0 +1,308 @@
+#include "breast_tumour_registration/ros/registration_node.h"
+
+#include <geometry_msgs/TransformStamped.h>
+#include <shape_msgs/Mesh.h>
+#include <visualization_msgs/Marker.h>
+
+#include <chrono>
+
+#include "breast_tumour_registration/RegistrationResult.h"
+#include "breast_tumour_registration/core/depth_camera.h"
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/ros/converters.h"
+
+namespace btr {
+namespace {
+
+Vec3 read_vec3(const ros::NodeHandle& pnh, const std::string& name, const Vec3& def) {
+  std::vector<double> v;
+  if (!pnh.getParam(name, v)) return def;
+  if (v.size() != 3) throw InputError("parameter ~" + name + " must be a list of 3 numbers");
+  return Vec3(v[0], v[1], v[2]);
+}
+
+}  // namespace
+
+NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
+  NodeParameters p;
+  pnh.param("scene", p.scene, p.scene);
+  pnh.param("working_frame", p.working_frame, p.working_frame);
+  pnh.param("model_frame", p.model_frame, p.model_frame);
+  pnh.param("preset", p.preset, p.preset);
+  pnh.param("voxel_size", p.voxel_size, p.voxel_size);
+  pnh.param("icp_every_n", p.icp_every_n, p.icp_every_n);
+  pnh.param("icp_max_iterations", p.icp_max_iterations, p.icp_max_iterations);
+  pnh.param("icp_max_correspondence", p.icp_max_correspondence, p.icp_max_correspondence);
+  pnh.param("max_depth_edge", p.max_depth_edge, p.max_depth_edge);
+  pnh.param("use_landmarks", p.use_landmarks, p.use_landmarks);
+  p.roi_min = read_vec3(pnh, "roi_min", p.roi_min);
+  p.roi_max = read_vec3(pnh, "roi_max", p.roi_max);
+  std::vector<double> pose;
+  if (pnh.getParam("initial_model_pose", pose)) {
+    if (pose.size() != 6) throw InputError("parameter ~initial_model_pose must be [x, y, z, roll, pitch, yaw]");
+    p.initial_model_pose.linear() = (Eigen::AngleAxisd(pose[5], Vec3::UnitZ()) * Eigen::AngleAxisd(pose[4], Vec3::UnitY()) *
+                                     Eigen::AngleAxisd(pose[3], Vec3::UnitX())).toRotationMatrix();
+    p.initial_model_pose.translation() = Vec3(pose[0], pose[1], pose[2]);
+  }
+  preset_options(p.preset);  // throws for an unknown preset
+  if (!(p.voxel_size > 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
+      !(p.max_depth_edge > 0))
+    throw InputError("parameters ~voxel_size, ~icp_max_correspondence, ~max_depth_edge must be > 0 and "
+                     "~icp_every_n, ~icp_max_iterations >= 1");
+  if ((p.roi_max - p.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
+  return p;
+}
+
+RegistrationNode::RegistrationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
+    : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_) {
+  params_ = read_node_parameters(pnh_);
+  icp_guess_ = params_.initial_model_pose;
+  status_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("status", 1, true);
+  mesh_pub_ = pnh_.advertise<shape_msgs::Mesh>("tumour_mesh", 1, true);
+  marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("tumour_marker", 10, true);
+  breast_marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("breast_marker", 1, true);
+  result_pub_ = pnh_.advertise<breast_tumour_registration::RegistrationResult>("result", 1, true);
+  load_scene();
+  cloud_sub_ = nh_.subscribe("points", 2, &RegistrationNode::on_cloud, this);
+  // The service has its own queue and two threads: a registration never blocks the cloud
+  // callback, and a second request is answered while the first one runs.
+  ros::AdvertiseServiceOptions ops = ros::AdvertiseServiceOptions::create<breast_tumour_registration::Register>(
+      "register",
+      [this](breast_tumour_registration::Register::Request& req, breast_tumour_registration::Register::Response& res) {
+        return on_register(req, res);
+      },
+      ros::VoidConstPtr(), &service_queue_);
+  register_srv_ = pnh_.advertiseService(ops);
+  service_spinner_ = std::make_unique<ros::AsyncSpinner>(2, &service_queue_);
+  service_spinner_->start();
+}
+
+RegistrationNode::~RegistrationNode() {
+  if (service_spinner_) service_spinner_->stop();
+}
+
+void RegistrationNode::load_scene() {
+  try {
+    if (params_.scene.empty()) throw InputError("parameter ~scene is not set (path of a scene YAML file)");
+    const auto t0 = std::chrono::steady_clock::now();
+    scene_ = btr::load_scene(params_.scene);
+    std::vector<std::string> warnings;
+    model_ = prepare_model(*scene_, warnings);
+    for (const auto& w : warnings) ROS_WARN_STREAM("scene: " << w);
+    if (!scene_->prone_rigid) ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ROS_INFO("loaded scene %s: %ld vertices, %ld tetrahedra, %zu tumours in %.2f s", params_.scene.c_str(),
+             static_cast<long>(model_->rest.V.rows()), static_cast<long>(model_->rest.T.rows()), model_->tumours.size(), s);
+    publish_status(diagnostic_msgs::DiagnosticStatus::OK, "scene loaded; waiting for depth clouds");
+  } catch (const std::exception& e) {
+    scene_.reset();
+    model_.reset();
+    scene_error_ = e.what();
+    ROS_ERROR_STREAM("cannot load the scene: " << scene_error_ << " (the node keeps running; fix ~scene and restart)");
+    publish_status(diagnostic_msgs::DiagnosticStatus::ERROR, "scene failed to load: " + scene_error_);
+  }
+}
+
+void RegistrationNode::publish_status(uint8_t level, const std::string& message) {
+  diagnostic_msgs::DiagnosticStatus st;
+  st.level = level;
+  st.name = ros::this_node::getName();
+  st.message = message;
+  st.hardware_id = params_.scene;
+  status_pub_.publish(st);
+}
+
+void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  try {
+    ros_conv::CloudPoints c = ros_conv::from_cloud(*msg, true);
+    if (c.points.rows() == 0) throw InputError("empty point cloud");
+    if (c.finite == 0) throw InputError("point cloud has no finite point (all NaN)");
+    geometry_msgs::TransformStamped tf;
+    try {
+      tf = tf_buffer_.lookupTransform(params_.working_frame, msg->header.frame_id, msg->header.stamp, ros::Duration(0.05));
+    } catch (const tf2::TransformException& e) {
+      throw InputError("no transform from '" + msg->header.frame_id + "' to '" + params_.working_frame + "': " + e.what());
+    }
+    const Rigid T = ros_conv::from_transform(tf.transform);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Points finite;
+    finite.resize(c.finite, 3);
+    Eigen::Index k = 0;
+    for (Eigen::Index i = 0; i < c.points.rows(); ++i) {
+      if (!c.points.row(i).allFinite()) continue;
+      const Vec3 p = T * Vec3(c.points.row(i).transpose());
+      if ((p.array() < params_.roi_min.array()).any() || (p.array() > params_.roi_max.array()).any()) {
+        c.points.row(i).setConstant(nan);
+        continue;
+      }
+      c.points.row(i) = p.transpose();
+      finite.row(k++) = p.transpose();
+    }
+    finite.conservativeResize(k, 3);
+    if (k == 0) throw InputError("no point of the cloud lies inside the region of interest (~roi_min, ~roi_max)");
+    {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      latest_cloud_ = std::move(c.points);
+      latest_width_ = c.organized ? c.width : 0;
+      latest_height_ = c.organized ? c.height : 0;
+      latest_stamp_ = msg->header.stamp;
+      have_cloud_ = true;
+      ++clouds_seen_;
+    }
+    if (!model_ || !scene_->prone_rigid || (clouds_seen_ - 1) % params_.icp_every_n != 0) return;
+    // Track the model's rigid region (chest ring) in the cloud, warm-started.
+    IcpOptions opt;
+    opt.voxel_size = params_.voxel_size;
+    opt.max_iterations = params_.icp_max_iterations;
+    opt.max_correspondence_distance = params_.icp_max_correspondence;
+    opt.coarse_correspondence_distance = model_to_working_ ? 0.0 : 0.05;  // wide capture only until locked on
+    opt.min_overlap = 0.2;
+    const IcpResult r = align_icp(scene_->prone_rigid->V, finite, icp_guess_, opt);
+    if (!r.accepted) {
+      ROS_WARN_THROTTLE(2.0, "depth tracking: %s (cloud far from the model? check ~initial_model_pose and the ROI)",
+                        r.message.c_str());
+      return;
+    }
+    {
+      std::lock_guard<std::mutex> lock(state_mutex_);
+      model_to_working_ = r.transform;
+      icp_guess_ = r.transform;
+    }
+    geometry_msgs::TransformStamped out;
+    out.header.stamp = msg->header.stamp;
+    out.header.frame_id = params_.working_frame;
+    out.child_frame_id = params_.model_frame;
+    out.transform = ros_conv::to_transform(r.transform);
+    tf_broadcaster_.sendTransform(out);
+  } catch (const InputError& e) {
+    ROS_ERROR_THROTTLE(1.0, "depth cloud rejected: %s", e.what());
+    publish_status(diagnostic_msgs::DiagnosticStatus::WARN, std::string("depth cloud rejected: ") + e.what());
+  } catch (const std::exception& e) {
+    ROS_ERROR_THROTTLE(1.0, "depth cloud processing failed: %s", e.what());
+  }
+}
+
+bool RegistrationNode::on_register(breast_tumour_registration::Register::Request& req,
+                                   breast_tumour_registration::Register::Response& res) {
+  std::unique_lock<std::mutex> busy(registration_mutex_, std::try_to_lock);
+  if (!busy.owns_lock()) {
+    res.success = false;
+    res.message = "a registration is already running; wait for its result on ~result and call again";
+    return true;
+  }
+  try {
+    if (!model_) throw InputError("the scene failed to load: " + scene_error_ + "; fix ~scene and restart the node");
+    const std::string preset = req.preset.empty() ? params_.preset : req.preset;
+    RegistrationOptions opt = preset_options(preset);
+    Scene scene = *scene_;
+    scene.preset = preset;
+    if (req.use_latest_cloud) {
+      Points cloud;
+      int w, h;
+      std::optional<Rigid> T;
+      {
+        std::lock_guard<std::mutex> lock(state_mutex_);
+        if (!have_cloud_)
+          throw InputError("no depth cloud has been received on '" + cloud_sub_.getTopic() +
+                           "' yet; start the camera or play a bag, then call again");
+        cloud = latest_cloud_;
+        w = latest_width_;
+        h = latest_height_;
+        T = model_to_working_;
+      }
+      if (!T)
+        throw InputError("the model is not aligned with the depth cloud yet (ICP rejected every cloud); make sure the "
+                         "chest around the breast is in view and ~initial_model_pose is close");
+      if (w == 0) throw InputError("the latest cloud is not organized; the surface step needs an organized depth image");
+      scene.supine_surface = triangulate_organized(cloud, w, h, params_.max_depth_edge);
+      // The scene's supine data (landmarks, ground truth) is in the model's supine frame:
+      // place it in the working frame with the tracked alignment.
+      if (params_.use_landmarks && scene.landmark_supine.rows()) scene.landmark_supine = transform_points(*T, scene.landmark_supine);
+      else {
+        scene.landmark_anchors.clear();
+        scene.landmark_supine.resize(0, 3);
+      }
+      for (auto& t : scene.tumours)
+        if (t.supine_ground_truth) t.supine_ground_truth = transform_surface(*T, *t.supine_ground_truth);
+      scene.steps.clear();
+      opt.known_supine_to_model = T->inverse();
+    }
+    publish_status(diagnostic_msgs::DiagnosticStatus::OK, "registration running (" + preset + ")");
+    const RegistrationResult r = run_registration(scene, *model_, opt);
+    publish_result(r, *model_, preset, res.result);
+    res.success = true;
+    res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")" +
+                  (r.converged ? "" : "; a step stopped without converging, try the accurate preset");
+    publish_status(r.converged ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN, res.message);
+  } catch (const InputError& e) {
+    res.success = false;
+    res.message = e.what();
+    ROS_ERROR_STREAM("registration refused: " << e.what());
+    publish_status(diagnostic_msgs::DiagnosticStatus::ERROR, res.message);
+  } catch (const std::exception& e) {
+    res.success = false;
+    res.message = std::string("registration failed: ") + e.what();
+    ROS_ERROR_STREAM(res.message);
+    publish_status(diagnostic_msgs::DiagnosticStatus::ERROR, res.message);
+  }
+  return true;
+}
+
+void RegistrationNode::publish_result(const RegistrationResult& r, const RegistrationModel& model,
+                                      const std::string& preset, breast_tumour_registration::RegistrationResult& out) {
+  const ros::Time now = ros::Time::now();
+  const std::string& frame = params_.working_frame;
+  out.header.stamp = now;
+  out.header.frame_id = frame;
+  out.preset = preset;
+  out.steps = r.steps.describe();
+  out.converged = r.converged;
+  out.registration_seconds = r.seconds;
+  out.landmark_residual_mean = r.landmark_residual_mean;
+  out.skin_distance_mean = r.skin_distance_mean;
+  out.warnings = r.warnings;
+  for (const auto& s : r.reports) {
+    out.step_names.push_back(s.name);
+    out.step_seconds.push_back(s.seconds);
+  }
+  const Rigid model_to_working = r.supine_to_model.inverse();
+  out.model_to_working.header = out.header;
+  out.model_to_working.child_frame_id = params_.model_frame;
+  out.model_to_working.transform = ros_conv::to_transform(model_to_working);
+  int id = 0;
+  for (const auto& t : r.tumours) {
+    breast_tumour_registration::TumourResult tm;
+    tm.name = t.name;
+    tm.mesh = ros_conv::to_mesh(t.registered);
+    tm.centroid.header = out.header;
+    tm.centroid.point.x = t.centroid.x();
+    tm.centroid.point.y = t.centroid.y();
+    tm.centroid.point.z = t.centroid.z();
+    tm.volume_ratio = t.volume_ratio;
+    tm.axis_ratio = t.axis_ratio;
+    tm.prone_axis_ratio = t.prone_axis_ratio;
+    tm.has_ground_truth = t.has_ground_truth;
+    tm.centroid_error = t.centroid_distance;
+    out.tumours.push_back(tm);
+    auto mk = ros_conv::to_marker(t.registered, frame, "tumour", id++, 0.9f, 0.2f, 0.2f, 0.9f);
+    mk.header.stamp = now;
+    marker_pub_.publish(mk);
+    geometry_msgs::TransformStamped tf;
+    tf.header = out.header;
+    tf.child_frame_id = "tumour_" + t.name;
+    tf.transform.translation.x = t.centroid.x();
+    tf.transform.translation.y = t.centroid.y();
+    tf.transform.translation.z = t.centroid.z();
+    tf.transform.rotation.w = 1.0;
+    tf_broadcaster_.sendTransform(tf);
+  }
+  if (!out.tumours.empty()) mesh_pub_.publish(out.tumours.front().mesh);
+  const SurfaceMesh skin = transform_surface(model_to_working, boundary_surface(TetMesh{r.x, model.rest.T}));
+  auto bm = ros_conv::to_marker(skin, frame, "breast", 0, 0.9f, 0.75f, 0.65f, 0.4f);
+  bm.header.stamp = now;
+  breast_marker_pub_.publish(bm);
+  result_pub_.publish(out);
+}
+
+}  // namespace btr

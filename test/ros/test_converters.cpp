@@ -1,0 +1,78 @@
+// Unit tests of the ROS message converters (no master needed).
+#include <gtest/gtest.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+
+#include <cmath>
+#include <limits>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/ros/converters.h"
+
+using namespace btr;
+
+TEST(Converters, OrganizedCloudKeepsItsLayoutOrDropsNaN) {
+  Points P(6, 3);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  P << 0, 0, 1, 1, 0, 1, nan, nan, nan, 0, 1, 1, 1, 1, 1, 2, 1, 1;
+  const auto msg = ros_conv::to_cloud(P, 3, 2, "camera");
+  EXPECT_EQ(msg.header.frame_id, "camera");
+  const auto keep = ros_conv::from_cloud(msg, true);
+  EXPECT_TRUE(keep.organized);
+  EXPECT_EQ(keep.points.rows(), 6);
+  EXPECT_EQ(keep.finite, 5);
+  EXPECT_TRUE(std::isnan(keep.points(2, 0)));
+  EXPECT_DOUBLE_EQ(keep.points(5, 0), 2.0);
+  const auto drop = ros_conv::from_cloud(msg, false);
+  EXPECT_FALSE(drop.organized);
+  EXPECT_EQ(drop.points.rows(), 5);
+  EXPECT_TRUE(drop.points.allFinite());
+}
+
+TEST(Converters, Float64FieldsAndMalformedClouds) {
+  sensor_msgs::PointCloud2 msg;
+  sensor_msgs::PointCloud2Modifier mod(msg);
+  mod.setPointCloud2Fields(3, "x", 1, sensor_msgs::PointField::FLOAT64, "y", 1, sensor_msgs::PointField::FLOAT64, "z", 1,
+                           sensor_msgs::PointField::FLOAT64);
+  mod.resize(2);
+  sensor_msgs::PointCloud2Iterator<double> x(msg, "x"), y(msg, "y"), z(msg, "z");
+  *x = 0.25; *y = -0.5; *z = 1.0;
+  ++x; ++y; ++z;
+  *x = 1.0; *y = 2.0; *z = 3.0;
+  const auto c = ros_conv::from_cloud(msg, false);
+  ASSERT_EQ(c.points.rows(), 2);
+  EXPECT_DOUBLE_EQ(c.points(0, 1), -0.5);
+  sensor_msgs::PointCloud2 no_xyz;
+  try {
+    ros_conv::from_cloud(no_xyz, false);
+    ADD_FAILURE() << "a cloud without x, y, z must be rejected";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no x, y, z fields"), std::string::npos);
+  }
+  sensor_msgs::PointCloud2 truncated = msg;
+  truncated.data.resize(10);
+  EXPECT_THROW(ros_conv::from_cloud(truncated, false), InputError);
+}
+
+TEST(Converters, MeshMarkerAndTransformRoundTrips) {
+  const SurfaceMesh s = make_icosphere(Vec3(0.1, 0.2, 0.3), 0.01, 1);
+  const shape_msgs::Mesh m = ros_conv::to_mesh(s);
+  const SurfaceMesh back = ros_conv::from_mesh(m);
+  EXPECT_EQ(back.F, s.F);
+  EXPECT_LT((back.V - s.V).cwiseAbs().maxCoeff(), 1e-15);
+  const auto mk = ros_conv::to_marker(s, "world", "tumour", 3, 1, 0, 0, 1);
+  EXPECT_EQ(mk.points.size(), static_cast<size_t>(3 * s.F.rows()));
+  EXPECT_EQ(mk.type, visualization_msgs::Marker::TRIANGLE_LIST);
+  Rigid T = Rigid::Identity();
+  T.linear() = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  T.translation() = Vec3(0.1, -0.2, 0.75);
+  EXPECT_LT((ros_conv::from_transform(ros_conv::to_transform(T)).matrix() - T.matrix()).norm(), 1e-12);
+  shape_msgs::Mesh bad = m;
+  bad.triangles[0].vertex_indices[1] = 100000;
+  EXPECT_THROW(ros_conv::from_mesh(bad), InputError);
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
