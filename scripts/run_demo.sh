@@ -1,24 +1,43 @@
 #!/usr/bin/env bash
 # The README's main command: installs what is missing, builds, and runs the main job on the
-# built-in default scene: the thesis's synthetic phantom (E = 3400 Pa), registered from prone
-# to supine with a simulated 10 deg / 5 mm misalignment of the supine scan.
+# built-in default scene (the thesis's synthetic phantom, E = 3400 Pa):
+#   1. btr_phantom generates the scene (prone and supine under gravity, tumours, landmarks);
+#   2. btr_register registers it on plain files, with the supine scan misaligned by 10 deg / 5 mm;
+#   3. btr_make_bag renders the supine phantom as a depth camera sees it (640 x 480, 1 mm noise);
+#   4. roslaunch demo.launch starts a master, the registration node, bag replay and a client that
+#      calls the service and prints the tumour centroid error and timings; everything stops after.
 # Outputs go to out/demo (override with BTR_OUT).
 set -euo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$REPO_ROOT/scripts/setup.sh"
 OUT="${BTR_OUT:-$REPO_ROOT/out/demo}"
 BIN="$REPO_ROOT/build/ws/devel/lib/breast_tumour_registration"
+mkdir -p "$OUT"
 echo
-echo "[demo] 1/2 generating the synthetic phantom (thesis Sec. 5.2.1) into $OUT/scene"
+echo "[demo] 1/4 generating the synthetic phantom (thesis Sec. 5.2.1) into $OUT/scene"
 "$BIN/btr_phantom" --out "$OUT/scene" --youngs-modulus 3400 --cell-size 6 --quiet
-# The supine data of the default scene is misaligned on purpose: the rigid step must undo it.
 cp "$OUT/scene/scene.yaml" "$OUT/scene/scene_misaligned.yaml"
 echo "misalignment: {rotation_deg: [10, 0, 5], translation_mm: [5, -3, 4]}" >> "$OUT/scene/scene_misaligned.yaml"
 echo
-echo "[demo] 2/2 registering prone -> supine (rigid + landmark + surface steps) into $OUT/registration"
-rc=0
-"$BIN/btr_register" "$OUT/scene/scene_misaligned.yaml" --out "$OUT/registration" --preset balanced || rc=$?
+echo "[demo] 2/4 registering prone -> supine on files (rigid + landmark + surface) into $OUT/registration"
+"$BIN/btr_register" "$OUT/scene/scene_misaligned.yaml" --out "$OUT/registration" --preset balanced --quiet
 echo
-echo "[demo] done (exit $rc). Report: $OUT/registration/report.json; picture: $OUT/registration/cross_section.png;"
-echo "[demo] meshes: $OUT/registration/registered.vtk and tumour_*_registered.obj (open in ParaView or 3D Slicer)."
-exit $rc
+echo "[demo] 3/4 rendering the supine phantom as a depth camera sees it into $OUT/depth.bag"
+"$BIN/btr_make_bag" "$OUT/scene/scene.yaml" --out "$OUT/depth.bag" --frames 150
+echo
+echo "[demo] 4/4 ROS: registration node + rosbag play + service call (roslaunch starts and stops its own master)"
+set +u
+# shellcheck disable=SC1091
+source "$REPO_ROOT/build/ws/devel/setup.bash"
+set -u
+export ROS_HOME="${ROS_HOME:-$OUT/ros_home}" ROS_LOG_DIR="${ROS_LOG_DIR:-$OUT/ros_log}"
+export ROS_MASTER_URI="http://localhost:${BTR_ROS_PORT:-11411}"
+rc=0
+timeout 180 roslaunch --port "${BTR_ROS_PORT:-11411}" breast_tumour_registration demo.launch \
+  scene:="$OUT/scene/scene.yaml" bag:="$OUT/depth.bag" 2>&1 |
+  grep --line-buffered -vE "TF_REPEATED_DATA|^\s*$|^ \* |PARAMETERS|NODES|SUMMARY|^    |process\[|auto-starting|setting /run_id|Checking log|Done checking|xml is deprecated|started core service|ROS_MASTER_URI" || rc=$?
+rc=${PIPESTATUS[0]}
+echo
+echo "[demo] done (exit $rc). Files: $OUT/registration/report.json, $OUT/registration/cross_section.png,"
+echo "[demo] $OUT/registration/registered.vtk and tumour_*_registered.obj (ParaView, 3D Slicer); bag: $OUT/depth.bag"
+exit "$rc"

@@ -36,6 +36,7 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   pnh.param("icp_max_correspondence", p.icp_max_correspondence, p.icp_max_correspondence);
   pnh.param("max_depth_edge", p.max_depth_edge, p.max_depth_edge);
   pnh.param("use_landmarks", p.use_landmarks, p.use_landmarks);
+  pnh.param("min_tracked_clouds", p.min_tracked_clouds, p.min_tracked_clouds);
   p.roi_min = read_vec3(pnh, "roi_min", p.roi_min);
   p.roi_max = read_vec3(pnh, "roi_max", p.roi_max);
   std::vector<double> pose;
@@ -47,9 +48,9 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   }
   preset_options(p.preset);  // throws for an unknown preset
   if (!(p.voxel_size > 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
-      !(p.max_depth_edge > 0))
+      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1)
     throw InputError("parameters ~voxel_size, ~icp_max_correspondence, ~max_depth_edge must be > 0 and "
-                     "~icp_every_n, ~icp_max_iterations >= 1");
+                     "~icp_every_n, ~icp_max_iterations, ~min_tracked_clouds >= 1");
   if ((p.roi_max - p.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
   return p;
 }
@@ -150,7 +151,7 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       have_cloud_ = true;
       ++clouds_seen_;
     }
-    if (!model_ || !scene_->prone_rigid || (clouds_seen_ - 1) % params_.icp_every_n != 0) return;
+    if (!model_ || !scene_->prone_rigid || registering_ || (clouds_seen_ - 1) % params_.icp_every_n != 0) return;
     // Track the model's rigid region (chest ring) in the cloud, warm-started.
     IcpOptions opt;
     opt.voxel_size = params_.voxel_size;
@@ -160,6 +161,10 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     opt.min_overlap = 0.2;
     const IcpResult r = align_icp(scene_->prone_rigid->V, finite, icp_guess_, opt);
     if (!r.accepted) {
+      {
+        std::lock_guard<std::mutex> lock(state_mutex_);
+        tracked_in_a_row_ = 0;
+      }
       ROS_WARN_THROTTLE(2.0, "depth tracking: %s (cloud far from the model? check ~initial_model_pose and the ROI)",
                         r.message.c_str());
       return;
@@ -168,6 +173,7 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       std::lock_guard<std::mutex> lock(state_mutex_);
       model_to_working_ = r.transform;
       icp_guess_ = r.transform;
+      ++tracked_in_a_row_;
     }
     geometry_msgs::TransformStamped out;
     out.header.stamp = msg->header.stamp;
@@ -201,6 +207,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       Points cloud;
       int w, h;
       std::optional<Rigid> T;
+      int tracked = 0;
       {
         std::lock_guard<std::mutex> lock(state_mutex_);
         if (!have_cloud_)
@@ -210,10 +217,14 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
         w = latest_width_;
         h = latest_height_;
         T = model_to_working_;
+        tracked = tracked_in_a_row_;
       }
       if (!T)
         throw InputError("the model is not aligned with the depth cloud yet (ICP rejected every cloud); make sure the "
                          "chest around the breast is in view and ~initial_model_pose is close");
+      if (tracked < params_.min_tracked_clouds)
+        throw InputError("the depth tracking is settling (" + std::to_string(tracked) + " of " +
+                         std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
       if (w == 0) throw InputError("the latest cloud is not organized; the surface step needs an organized depth image");
       scene.supine_surface = triangulate_organized(cloud, w, h, params_.max_depth_edge);
       // The scene's supine data (landmarks, ground truth) is in the model's supine frame:
@@ -229,6 +240,11 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       opt.known_supine_to_model = T->inverse();
     }
     publish_status(diagnostic_msgs::DiagnosticStatus::OK, "registration running (" + preset + ")");
+    struct Flag {
+      std::atomic<bool>& f;
+      explicit Flag(std::atomic<bool>& x) : f(x) { f = true; }
+      ~Flag() { f = false; }
+    } running(registering_);
     const RegistrationResult r = run_registration(scene, *model_, opt);
     publish_result(r, *model_, preset, res.result);
     res.success = true;

@@ -37,6 +37,7 @@ struct NodeParameters {
   Rigid initial_model_pose = Rigid::Identity();  ///< ~initial_model_pose [x y z roll pitch yaw], working frame
   double max_depth_edge = 0.01;           ///< ~max_depth_edge [m]: no surface across depth jumps
   bool use_landmarks = true;              ///< ~use_landmarks with the live cloud
+  int min_tracked_clouds = 10;            ///< ~min_tracked_clouds: consecutive ICP successes before registering
 };
 
 /// Reads the parameters with defaults; throws InputError naming a parameter out of range.
@@ -71,8 +72,10 @@ class RegistrationNode {
   std::optional<Rigid> model_to_working_;
   Rigid icp_guess_;
   long clouds_seen_ = 0;
+  int tracked_in_a_row_ = 0;
   // Registration runs one at a time; a second request gets an answer, not a deadlock.
   std::mutex registration_mutex_;
+  std::atomic<bool> registering_{false};  ///< tracking pauses meanwhile: both would share two cores
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
