@@ -58,7 +58,6 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
 RegistrationNode::RegistrationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_) {
   params_ = read_node_parameters(pnh_);
-  icp_guess_ = params_.initial_model_pose;
   status_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("status", 1, true);
   mesh_pub_ = pnh_.advertise<shape_msgs::Mesh>("tumour_mesh", 1, true);
   marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("tumour_marker", 10, true);
@@ -126,60 +125,53 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       throw InputError("no transform from '" + msg->header.frame_id + "' to '" + params_.working_frame + "': " + e.what());
     }
     const Rigid T = ros_conv::from_transform(tf.transform);
-    const double nan = std::numeric_limits<double>::quiet_NaN();
-    Points finite;
-    finite.resize(c.finite, 3);
-    Eigen::Index k = 0;
-    for (Eigen::Index i = 0; i < c.points.rows(); ++i) {
-      if (!c.points.row(i).allFinite()) continue;
-      const Vec3 p = T * Vec3(c.points.row(i).transpose());
-      if ((p.array() < params_.roi_min.array()).any() || (p.array() > params_.roi_max.array()).any()) {
-        c.points.row(i).setConstant(nan);
-        continue;
+    std::unique_lock<std::mutex> lock(state_mutex_);
+    if (!tracker_) {
+      // Without a rigid region there is nothing to track; the cloud is still kept (ROI only).
+      DepthTrackerOptions o;
+      o.voxel_size = params_.voxel_size;
+      o.max_iterations = params_.icp_max_iterations;
+      o.max_correspondence = params_.icp_max_correspondence;
+      o.roi_min = params_.roi_min;
+      o.roi_max = params_.roi_max;
+      Points region = (model_ && scene_->prone_rigid) ? scene_->prone_rigid->V : Points::Zero(6, 3);
+      tracker_.emplace(region, params_.initial_model_pose, o);
+    }
+    const bool track = model_ && scene_->prone_rigid && !registering_ && clouds_seen_ % params_.icp_every_n == 0;
+    TrackingResult r;
+    if (track) {
+      r = tracker_->process(c.points, T);
+    } else {
+      // Keep the cloud in the working frame (ROI applied) without aligning it.
+      for (Eigen::Index i = 0; i < c.points.rows(); ++i) {
+        if (!c.points.row(i).allFinite()) continue;
+        const Vec3 p = T * Vec3(c.points.row(i).transpose());
+        if ((p.array() < params_.roi_min.array()).any() || (p.array() > params_.roi_max.array()).any())
+          c.points.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+        else
+          c.points.row(i) = p.transpose();
       }
-      c.points.row(i) = p.transpose();
-      finite.row(k++) = p.transpose();
     }
-    finite.conservativeResize(k, 3);
-    if (k == 0) throw InputError("no point of the cloud lies inside the region of interest (~roi_min, ~roi_max)");
-    {
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      latest_cloud_ = std::move(c.points);
-      latest_width_ = c.organized ? c.width : 0;
-      latest_height_ = c.organized ? c.height : 0;
-      latest_stamp_ = msg->header.stamp;
-      have_cloud_ = true;
-      ++clouds_seen_;
-    }
-    if (!model_ || !scene_->prone_rigid || registering_ || (clouds_seen_ - 1) % params_.icp_every_n != 0) return;
-    // Track the model's rigid region (chest ring) in the cloud, warm-started.
-    IcpOptions opt;
-    opt.voxel_size = params_.voxel_size;
-    opt.max_iterations = params_.icp_max_iterations;
-    opt.max_correspondence_distance = params_.icp_max_correspondence;
-    opt.coarse_correspondence_distance = model_to_working_ ? 0.0 : 0.05;  // wide capture only until locked on
-    opt.min_overlap = 0.2;
-    const IcpResult r = align_icp(scene_->prone_rigid->V, finite, icp_guess_, opt);
+    latest_cloud_ = std::move(c.points);
+    latest_width_ = c.organized ? c.width : 0;
+    latest_height_ = c.organized ? c.height : 0;
+    latest_stamp_ = msg->header.stamp;
+    have_cloud_ = true;
+    ++clouds_seen_;
+    if (!track) return;
     if (!r.accepted) {
-      {
-        std::lock_guard<std::mutex> lock(state_mutex_);
-        tracked_in_a_row_ = 0;
-      }
+      lock.unlock();
       ROS_WARN_THROTTLE(2.0, "depth tracking: %s (cloud far from the model? check ~initial_model_pose and the ROI)",
-                        r.message.c_str());
+                        r.icp.message.c_str());
       return;
     }
-    {
-      std::lock_guard<std::mutex> lock(state_mutex_);
-      model_to_working_ = r.transform;
-      icp_guess_ = r.transform;
-      ++tracked_in_a_row_;
-    }
+    const Rigid pose = *tracker_->pose();
+    lock.unlock();
     geometry_msgs::TransformStamped out;
     out.header.stamp = msg->header.stamp;
     out.header.frame_id = params_.working_frame;
     out.child_frame_id = params_.model_frame;
-    out.transform = ros_conv::to_transform(r.transform);
+    out.transform = ros_conv::to_transform(pose);
     tf_broadcaster_.sendTransform(out);
   } catch (const InputError& e) {
     ROS_ERROR_THROTTLE(1.0, "depth cloud rejected: %s", e.what());
@@ -216,8 +208,10 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
         cloud = latest_cloud_;
         w = latest_width_;
         h = latest_height_;
-        T = model_to_working_;
-        tracked = tracked_in_a_row_;
+        if (tracker_) {
+          T = tracker_->pose();
+          tracked = tracker_->consecutive();
+        }
       }
       if (!T)
         throw InputError("the model is not aligned with the depth cloud yet (ICP rejected every cloud); make sure the "

@@ -19,7 +19,7 @@
 #include <string>
 
 #include "breast_tumour_registration/Register.h"
-#include "breast_tumour_registration/core/icp_alignment.h"
+#include "breast_tumour_registration/core/depth_tracker.h"
 #include "breast_tumour_registration/core/registration_pipeline.h"
 
 namespace btr {
@@ -69,10 +69,8 @@ class RegistrationNode {
   int latest_width_ = 0, latest_height_ = 0;
   bool have_cloud_ = false;
   ros::Time latest_stamp_;
-  std::optional<Rigid> model_to_working_;
-  Rigid icp_guess_;
+  std::optional<DepthTracker> tracker_;
   long clouds_seen_ = 0;
-  int tracked_in_a_row_ = 0;
   // Registration runs one at a time; a second request gets an answer, not a deadlock.
   std::mutex registration_mutex_;
   std::atomic<bool> registering_{false};  ///< tracking pauses meanwhile: both would share two cores

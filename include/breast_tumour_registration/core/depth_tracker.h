@@ -1,0 +1,55 @@
+// Tracking of the prone model's rigid region (the chest skin around the breast) in a stream
+// of depth clouds: each cloud is moved into the working frame, cropped to a region of
+// interest and aligned by warm-started ICP. Used by the ROS node and by the tracking
+// benchmark, so that the figures measure the node's own code path.
+#pragma once
+
+#include <optional>
+
+#include "breast_tumour_registration/core/icp_alignment.h"
+
+namespace btr {
+
+struct DepthTrackerOptions {
+  double voxel_size = 0.004;              ///< [m]
+  int max_iterations = 10;                ///< per cloud, once locked on
+  double max_correspondence = 0.01;       ///< [m]
+  double capture_correspondence = 0.05;   ///< [m] wide first pass until the first success
+  int capture_iterations = 40;
+  Vec3 roi_min = Vec3::Constant(-1e9), roi_max = Vec3::Constant(1e9);  ///< working frame [m]
+  double min_overlap = 0.2;
+};
+
+struct TrackingResult {
+  bool accepted = false;
+  IcpResult icp;
+  long points_in_roi = 0;
+  double seconds_filter = 0;  ///< transform and crop
+  double seconds_icp = 0;     ///< downsampling, normals and ICP
+};
+
+class DepthTracker {
+ public:
+  /// rigid_region: points of the model's rigid region in the model frame;
+  /// initial: a guess of model -> working frame.
+  DepthTracker(Points rigid_region, const Rigid& initial, const DepthTrackerOptions& opt);
+
+  /// cloud: organized or not, in the sensor frame, NaN allowed; on return it holds the
+  /// points in the working frame with those outside the ROI set to NaN (same layout).
+  /// Throws InputError when no finite point is left inside the ROI.
+  TrackingResult process(Points& cloud, const Rigid& sensor_to_working);
+
+  /// The last accepted model -> working transform, if any.
+  const std::optional<Rigid>& pose() const { return pose_; }
+  /// Consecutive accepted clouds (0 after a rejection).
+  int consecutive() const { return consecutive_; }
+
+ private:
+  Points rigid_;
+  Rigid guess_;
+  DepthTrackerOptions opt_;
+  std::optional<Rigid> pose_;
+  int consecutive_ = 0;
+};
+
+}  // namespace btr
