@@ -37,6 +37,7 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   pnh.param("max_depth_edge", p.max_depth_edge, p.max_depth_edge);
   pnh.param("use_landmarks", p.use_landmarks, p.use_landmarks);
   pnh.param("min_tracked_clouds", p.min_tracked_clouds, p.min_tracked_clouds);
+  pnh.param("rigid_margin", p.rigid_margin, p.rigid_margin);
   p.roi_min = read_vec3(pnh, "roi_min", p.roi_min);
   p.roi_max = read_vec3(pnh, "roi_max", p.roi_max);
   std::vector<double> pose;
@@ -48,7 +49,7 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   }
   preset_options(p.preset);  // throws for an unknown preset
   if (!(p.voxel_size > 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
-      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1)
+      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0))
     throw InputError("parameters ~voxel_size, ~icp_max_correspondence, ~max_depth_edge must be > 0 and "
                      "~icp_every_n, ~icp_max_iterations, ~min_tracked_clouds >= 1");
   if ((p.roi_max - p.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
@@ -90,7 +91,15 @@ void RegistrationNode::load_scene() {
     std::vector<std::string> warnings;
     model_ = prepare_model(*scene_, warnings);
     for (const auto& w : warnings) ROS_WARN_STREAM("scene: " << w);
-    if (!scene_->prone_rigid) ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
+    if (!scene_->prone_rigid) {
+      ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
+    } else {
+      // The supine breast bulges over the chest skin next to it: track only the part clear of it.
+      tracked_region_ = rigid_region_clear_of(scene_->prone_rigid->V, boundary_surface(scene_->prone), params_.rigid_margin);
+      ROS_INFO("depth tracking on %ld of %ld chest-ring points (farther than %.0f mm from the breast)",
+               static_cast<long>(tracked_region_.rows()), static_cast<long>(scene_->prone_rigid->V.rows()),
+               params_.rigid_margin * 1e3);
+    }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ROS_INFO("loaded scene %s: %ld vertices, %ld tetrahedra, %zu tumours in %.2f s", params_.scene.c_str(),
              static_cast<long>(model_->rest.V.rows()), static_cast<long>(model_->rest.T.rows()), model_->tumours.size(), s);
@@ -134,7 +143,7 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       o.max_correspondence = params_.icp_max_correspondence;
       o.roi_min = params_.roi_min;
       o.roi_max = params_.roi_max;
-      Points region = (model_ && scene_->prone_rigid) ? scene_->prone_rigid->V : Points::Zero(6, 3);
+      Points region = tracked_region_.rows() >= 6 ? tracked_region_ : Points::Zero(6, 3);
       tracker_.emplace(region, params_.initial_model_pose, o);
     }
     const bool track = model_ && scene_->prone_rigid && !registering_ && clouds_seen_ % params_.icp_every_n == 0;

@@ -18,15 +18,25 @@ struct DepthTrackerOptions {
   int capture_iterations = 40;
   Vec3 roi_min = Vec3::Constant(-1e9), roi_max = Vec3::Constant(1e9);  ///< working frame [m]
   double min_overlap = 0.2;
+  /// Once locked on, only cloud points within about this distance of the rigid region (under
+  /// the current pose) take part: the deforming breast skin would bias the alignment [m];
+  /// <= 0 keeps every point.
+  double region_band = 0.008;
 };
 
 struct TrackingResult {
   bool accepted = false;
   IcpResult icp;
   long points_in_roi = 0;
+  long points_near_region = 0;  ///< after the rigid-region band filter (locked tracking)
   double seconds_filter = 0;  ///< transform and crop
   double seconds_icp = 0;     ///< downsampling, normals and ICP
 };
+
+/// The part of a rigid region farther than `margin` [m] from the breast surface `skin`:
+/// the deforming breast bulges over the nearest part of the chest skin in a depth view, so
+/// tracking on it would be biased. Throws InputError if fewer than 6 points remain.
+Points rigid_region_clear_of(const Points& region, const SurfaceMesh& skin, double margin);
 
 class DepthTracker {
  public:
@@ -45,7 +55,9 @@ class DepthTracker {
   int consecutive() const { return consecutive_; }
 
  private:
+  bool near_region(const Vec3& model_point) const;
   Points rigid_;
+  std::vector<long long> region_voxels_;  // sorted keys of the dilated rigid-region voxels
   Rigid guess_;
   DepthTrackerOptions opt_;
   std::optional<Rigid> pose_;

@@ -38,6 +38,7 @@ struct NodeParameters {
   double max_depth_edge = 0.01;           ///< ~max_depth_edge [m]: no surface across depth jumps
   bool use_landmarks = true;              ///< ~use_landmarks with the live cloud
   int min_tracked_clouds = 10;            ///< ~min_tracked_clouds: consecutive ICP successes before registering
+  double rigid_margin = 0.015;            ///< ~rigid_margin [m]: track chest-ring points this far from the breast
 };
 
 /// Reads the parameters with defaults; throws InputError naming a parameter out of range.
@@ -70,6 +71,7 @@ class RegistrationNode {
   bool have_cloud_ = false;
   ros::Time latest_stamp_;
   std::optional<DepthTracker> tracker_;
+  Points tracked_region_;  ///< the rigid region clear of the breast (model frame)
   long clouds_seen_ = 0;
   // Registration runs one at a time; a second request gets an answer, not a deadlock.
   std::mutex registration_mutex_;
