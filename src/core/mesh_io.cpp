@@ -61,6 +61,58 @@ long parse_long(const std::string& tok, const std::string& path, size_t line) {
   }
 }
 
+// The whitespace-separated tokens of a text file with their line numbers, for the formats
+// whose records span lines (OFF, legacy VTK, Medit).
+class TokenStream {
+ public:
+  struct Token {
+    std::string text;
+    size_t line;
+  };
+  /// hash_comments: '#' starts a comment; skip_line (1-based, 0: none) is ignored entirely;
+  /// check_first_line, when given, must start line 1.
+  TokenStream(const std::string& path, bool hash_comments, size_t skip_line = 0, const char* check_first_line = nullptr)
+      : path_(path) {
+    auto in = open_in(path);
+    std::string line;
+    size_t ln = 0;
+    while (std::getline(in, line)) {
+      ++ln;
+      if (ln == 1 && check_first_line && line.rfind(check_first_line, 0) != 0)
+        throw InputError(path + ":1: missing '" + check_first_line + "' header");
+      if (ln == skip_line) continue;
+      if (hash_comments) line = line.substr(0, line.find('#'));
+      std::istringstream ss(line);
+      std::string t;
+      while (ss >> t) tokens_.push_back({t, ln});
+    }
+    last_line_ = ln;
+  }
+  bool done() const { return pos_ >= tokens_.size(); }
+  const Token& peek() const { return tokens_[pos_]; }
+  const Token& next(const char* what) {
+    if (done()) fail(path_, last_line_, std::string("unexpected end of file, expected ") + what);
+    return tokens_[pos_++];
+  }
+  long next_long(const char* what) {
+    const Token& t = next(what);
+    return parse_long(t.text, path_, t.line);
+  }
+  double next_double(const char* what) {
+    const Token& t = next(what);
+    return parse_double(t.text, path_, t.line);
+  }
+  /// Skips the remaining tokens of `line`.
+  void skip_rest_of_line(size_t line) {
+    while (!done() && tokens_[pos_].line == line) ++pos_;
+  }
+
+ private:
+  std::string path_;
+  std::vector<Token> tokens_;
+  size_t pos_ = 0, last_line_ = 0;
+};
+
 Points to_points(const std::vector<Vec3>& v, double scale) {
   Points P(v.size(), 3);
   for (size_t i = 0; i < v.size(); ++i) P.row(i) = v[i].transpose() * scale;
@@ -135,54 +187,28 @@ void write_obj(const std::string& path, const SurfaceMesh& m, double inv) {
 
 // ---------------------------------------------------------------- OFF
 SurfaceMesh read_off(const std::string& path, double scale) {
-  auto in = open_in(path);
-  // Tokenize ignoring comments, tracking line numbers.
-  std::vector<std::pair<std::string, size_t>> toks;
-  std::string line;
-  size_t ln = 0;
-  while (std::getline(in, line)) {
-    ++ln;
-    line = line.substr(0, line.find('#'));
-    std::istringstream ss(line);
-    std::string t;
-    while (ss >> t) toks.emplace_back(t, ln);
-  }
-  size_t k = 0;
-  auto next = [&](const char* what) -> const std::pair<std::string, size_t>& {
-    if (k >= toks.size()) fail(path, ln, std::string("unexpected end of file, expected ") + what);
-    return toks[k++];
-  };
-  if (toks.empty() || lower(toks[0].first).find("off") == std::string::npos)
-    throw InputError(path + ": missing OFF header");
-  ++k;
-  auto nv_t = next("vertex count");
-  auto nf_t = next("face count");
-  next("edge count");
-  const long nv = parse_long(nv_t.first, path, nv_t.second);
-  const long nf = parse_long(nf_t.first, path, nf_t.second);
-  if (nv < 0 || nf < 0) fail(path, nv_t.second, "negative element count");
+  TokenStream ts(path, true);
+  if (ts.done() || lower(ts.peek().text).find("off") == std::string::npos) throw InputError(path + ": missing OFF header");
+  ts.next("header");
+  const long nv = ts.next_long("vertex count");
+  const long nf = ts.next_long("face count");
+  ts.next("edge count");
+  if (nv < 0 || nf < 0) throw InputError(path + ": negative element count");
   std::vector<Vec3> verts;
   verts.reserve(nv);
   for (long i = 0; i < nv; ++i) {
     Vec3 p;
-    for (int c = 0; c < 3; ++c) {
-      auto t = next("vertex coordinate");
-      p[c] = parse_double(t.first, path, t.second);
-    }
+    for (int c = 0; c < 3; ++c) p[c] = ts.next_double("vertex coordinate");
     verts.push_back(p);
   }
   std::vector<Eigen::Vector3i> tris;
   for (long i = 0; i < nf; ++i) {
-    auto t = next("face size");
-    const long n = parse_long(t.first, path, t.second);
+    const size_t line = ts.done() ? 0 : ts.peek().line;
+    const long n = ts.next_long("face size");
     std::vector<int> poly;
-    for (long j = 0; j < n; ++j) {
-      auto u = next("face index");
-      poly.push_back(static_cast<int>(parse_long(u.first, path, u.second)));
-    }
-    add_polygon(tris, poly, path, t.second);
-    // Skip optional per-face colour: tokens on the same line after the indices.
-    while (k < toks.size() && toks[k].second == t.second) ++k;
+    for (long j = 0; j < n; ++j) poly.push_back(static_cast<int>(ts.next_long("face index")));
+    add_polygon(tris, poly, path, line);
+    ts.skip_rest_of_line(line);  // optional per-face colour
   }
   return finish(path, verts, tris, scale);
 }
@@ -406,67 +432,42 @@ void write_ply(const std::string& path, const SurfaceMesh& m, double inv) {
 
 // ---------------------------------------------------------------- VTK (legacy)
 TetMesh read_vtk(const std::string& path, double scale) {
-  auto in = open_in(path);
-  std::vector<std::pair<std::string, size_t>> toks;
-  std::string line;
-  size_t ln = 0;
-  while (std::getline(in, line)) {
-    ++ln;
-    if (ln == 1 && line.rfind("# vtk", 0) != 0) throw InputError(path + ":1: missing '# vtk DataFile' header");
-    if (ln == 2) continue;  // free-form title
-    std::istringstream ss(line);
-    std::string t;
-    while (ss >> t) toks.emplace_back(t, ln);
-  }
-  size_t k = 0;
-  auto next = [&](const char* what) -> const std::pair<std::string, size_t>& {
-    if (k >= toks.size()) fail(path, ln, std::string("unexpected end of file, expected ") + what);
-    return toks[k++];
-  };
+  // Line 1 is the "# vtk DataFile" header, line 2 a free-form title.
+  TokenStream ts(path, false, 2, "# vtk");
+  ts.next("header");
+  while (!ts.done() && ts.peek().line == 1) ts.next("header");
   std::vector<Vec3> verts;
   std::vector<std::vector<int>> cells;
   std::vector<int> types;
   bool have_points = false, have_cells = false;
-  while (k < toks.size()) {
-    const auto tok = next("keyword");
-    const std::string kw = lower(tok.first);
-    if (kw == "ascii" || kw == "dataset") {
-      if (kw == "dataset") {
-        auto t = next("dataset type");
-        if (lower(t.first) != "unstructured_grid")
-          fail(path, t.second, "dataset '" + t.first + "' is not UNSTRUCTURED_GRID");
-      }
+  while (!ts.done()) {
+    const auto tok = ts.next("keyword");
+    const std::string kw = lower(tok.text);
+    if (kw == "ascii") {
+    } else if (kw == "dataset") {
+      const auto t = ts.next("dataset type");
+      if (lower(t.text) != "unstructured_grid") fail(path, t.line, "dataset '" + t.text + "' is not UNSTRUCTURED_GRID");
     } else if (kw == "binary") {
-      fail(path, tok.second, "binary legacy VTK is not supported; save as ASCII");
+      fail(path, tok.line, "binary legacy VTK is not supported; save as ASCII");
     } else if (kw == "points") {
-      const long n = parse_long(next("point count").first, path, tok.second);
-      next("point type");
+      const long n = ts.next_long("point count");
+      ts.next("point type");
       verts.resize(n);
       for (long i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c) {
-          auto t = next("coordinate");
-          verts[i][c] = parse_double(t.first, path, t.second);
-        }
+        for (int c = 0; c < 3; ++c) verts[i][c] = ts.next_double("coordinate");
       have_points = true;
     } else if (kw == "cells") {
-      const long n = parse_long(next("cell count").first, path, tok.second);
-      next("cell list size");
+      const long n = ts.next_long("cell count");
+      ts.next("cell list size");
       cells.resize(n);
       for (long i = 0; i < n; ++i) {
-        auto t = next("cell size");
-        const long m = parse_long(t.first, path, t.second);
-        for (long j = 0; j < m; ++j) {
-          auto u = next("cell index");
-          cells[i].push_back(static_cast<int>(parse_long(u.first, path, u.second)));
-        }
+        const long m = ts.next_long("cell size");
+        for (long j = 0; j < m; ++j) cells[i].push_back(static_cast<int>(ts.next_long("cell index")));
       }
       have_cells = true;
     } else if (kw == "cell_types") {
-      const long n = parse_long(next("cell type count").first, path, tok.second);
-      for (long i = 0; i < n; ++i) {
-        auto t = next("cell type");
-        types.push_back(static_cast<int>(parse_long(t.first, path, t.second)));
-      }
+      const long n = ts.next_long("cell type count");
+      for (long i = 0; i < n; ++i) types.push_back(static_cast<int>(ts.next_long("cell type")));
     } else if (kw == "point_data" || kw == "cell_data") {
       break;  // attributes are not needed
     }
@@ -507,55 +508,34 @@ void write_vtk(const std::string& path, const TetMesh& m, double inv) {
 
 // ---------------------------------------------------------------- Medit
 TetMesh read_medit(const std::string& path, double scale) {
-  auto in = open_in(path);
-  std::vector<std::pair<std::string, size_t>> toks;
-  std::string line;
-  size_t ln = 0;
-  while (std::getline(in, line)) {
-    ++ln;
-    line = line.substr(0, line.find('#'));
-    std::istringstream ss(line);
-    std::string t;
-    while (ss >> t) toks.emplace_back(t, ln);
-  }
-  size_t k = 0;
-  auto next = [&](const char* what) -> const std::pair<std::string, size_t>& {
-    if (k >= toks.size()) fail(path, ln, std::string("unexpected end of file, expected ") + what);
-    return toks[k++];
-  };
+  TokenStream ts(path, true);
   auto skip_block = [&](int per_item) {
-    const long n = parse_long(next("count").first, path, ln);
-    for (long i = 0; i < n * per_item; ++i) next("value");
+    const long n = ts.next_long("count");
+    for (long i = 0; i < n * per_item; ++i) ts.next("value");
   };
   std::vector<Vec3> verts;
   std::vector<Eigen::Vector4i> tets;
   bool have_v = false;
-  while (k < toks.size()) {
-    const auto tok = next("keyword");
-    const std::string kw = lower(tok.first);
+  while (!ts.done()) {
+    const auto tok = ts.next("keyword");
+    const std::string kw = lower(tok.text);
     if (kw == "meshversionformatted" || kw == "dimension") {
-      auto t = next("value");
-      if (kw == "dimension" && t.first != "3") fail(path, t.second, "only Dimension 3 is supported");
+      const auto t = ts.next("value");
+      if (kw == "dimension" && t.text != "3") fail(path, t.line, "only Dimension 3 is supported");
     } else if (kw == "vertices") {
-      const long n = parse_long(next("vertex count").first, path, tok.second);
+      const long n = ts.next_long("vertex count");
       verts.resize(n);
       for (long i = 0; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) {
-          auto t = next("coordinate");
-          verts[i][c] = parse_double(t.first, path, t.second);
-        }
-        next("vertex reference");
+        for (int c = 0; c < 3; ++c) verts[i][c] = ts.next_double("coordinate");
+        ts.next("vertex reference");
       }
       have_v = true;
     } else if (kw == "tetrahedra") {
-      const long n = parse_long(next("tetrahedron count").first, path, tok.second);
+      const long n = ts.next_long("tetrahedron count");
       for (long i = 0; i < n; ++i) {
         Eigen::Vector4i t;
-        for (int c = 0; c < 4; ++c) {
-          auto u = next("tetrahedron index");
-          t[c] = static_cast<int>(parse_long(u.first, path, u.second)) - 1;  // Medit is 1-based
-        }
-        next("tetrahedron reference");
+        for (int c = 0; c < 4; ++c) t[c] = static_cast<int>(ts.next_long("tetrahedron index")) - 1;  // 1-based
+        ts.next("tetrahedron reference");
         tets.push_back(t);
       }
     } else if (kw == "triangles") {
@@ -567,7 +547,7 @@ TetMesh read_medit(const std::string& path, double scale) {
     } else if (kw == "end") {
       break;
     } else {
-      fail(path, tok.second, "unknown Medit keyword '" + tok.first + "'");
+      fail(path, tok.line, "unknown Medit keyword '" + tok.text + "'");
     }
   }
   if (!have_v || tets.empty()) throw InputError(path + ": missing Vertices or Tetrahedra section");

@@ -7,6 +7,7 @@
 
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/line_search.h"
+#include "breast_tumour_registration/core/pcg.h"
 #include "breast_tumour_registration/core/tet_kinematics.h"
 
 namespace btr {
@@ -28,6 +29,54 @@ std::string to_string(StopReason r) {
   return "unknown";
 }
 
+StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
+                              const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
+                              long& n_inv, IterationInfo& info, NewtonResult& res) {
+  const double full_step = dx.rowwise().norm().maxCoeff();
+  if (full_step <= opt.step_tolerance) {
+    res.reason = StopReason::StepTolerance;
+    res.converged = true;
+    return StepOutcome::TooSmall;
+  }
+  const auto t0 = Clock::now();
+  const LineSearchResult ls = backtracking_line_search(energy, x, dx, E, slope, n_inv, tets, line_search_options(opt), x_trial);
+  info.t_line_search = since(t0);
+  res.t_assembly += info.t_assembly;
+  res.t_factorization += info.t_factorization;
+  res.t_solve += info.t_solve;
+  res.t_line_search += info.t_line_search;
+  if (!ls.accepted) {
+    res.reason = StopReason::LineSearchFailed;
+    return StepOutcome::NoDecrease;
+  }
+  x.swap(x_trial);
+  E = ls.energy;
+  n_inv = ls.inverted;
+  info.energy = E;
+  info.alpha = ls.alpha;
+  info.step_norm = ls.alpha * full_step;
+  info.inverted = n_inv;
+  return StepOutcome::Taken;
+}
+
+bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res) {
+  res.iterations = info.iteration;
+  res.energy = info.energy;
+  res.gradient_norm = info.gradient_norm;
+  res.inverted = info.inverted;
+  res.history.push_back(info);
+  if (opt.callback && !opt.callback(info)) {
+    res.reason = StopReason::Aborted;
+    return true;
+  }
+  if (info.gradient_norm <= gradient_tolerance || info.step_norm <= opt.step_tolerance) {
+    res.reason = info.gradient_norm <= gradient_tolerance ? StopReason::GradientTolerance : StopReason::StepTolerance;
+    res.converged = true;
+    return true;
+  }
+  return false;
+}
+
 LineSearchOptions line_search_options(const NewtonOptions& opt) {
   LineSearchOptions l;
   l.max_steps = opt.max_line_search_steps;
@@ -41,32 +90,6 @@ struct NewtonSolver::Impl {
   bool analyzed = false;
   bool have_factor = false;  // llt holds a factor of some earlier Hessian (same pattern)
 
-  // Preconditioned CG on H d = b with the lagged factor as preconditioner, started from
-  // the lagged Newton step M^-1 b. Returns false if the tolerance is not reached.
-  bool pcg(const Eigen::SparseMatrix<double>& H, const Eigen::VectorXd& b, double rel_tol, int max_it,
-           Eigen::VectorXd& d, int& iterations) {
-    d = llt.solve(b);
-    Eigen::VectorXd r = b - H.selfadjointView<Eigen::Lower>() * d;
-    const double stop = rel_tol * b.norm();
-    iterations = 0;
-    if (r.norm() <= stop) return true;
-    Eigen::VectorXd z = llt.solve(r), p = z, Hp(b.size());
-    double rz = r.dot(z);
-    for (iterations = 1; iterations <= max_it; ++iterations) {
-      Hp.noalias() = H.selfadjointView<Eigen::Lower>() * p;
-      const double pHp = p.dot(Hp);
-      if (!(pHp > 0)) return false;
-      const double a = rz / pHp;
-      d += a * p;
-      r -= a * Hp;
-      if (r.norm() <= stop) return d.allFinite();
-      z = llt.solve(r);
-      const double rz_new = r.dot(z);
-      p = z + (rz_new / rz) * p;
-      rz = rz_new;
-    }
-    return false;
-  }
 };
 
 NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
@@ -112,7 +135,10 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     if (opt.reuse_factorization && impl_->have_factor) {
       t0 = Clock::now();
       const double eta = std::min(opt.max_forcing, std::sqrt(g.norm() / std::max(res.initial_gradient_norm, 1e-300)));
-      solved = impl_->pcg(H.matrix(), -g, eta, opt.max_pcg_iterations, d, info.pcg_iterations);
+      const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
+      solved = preconditioned_cg([&](const Eigen::VectorXd& v) { return Eigen::VectorXd(Hs * v); },
+                                 [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(impl_->llt.solve(v)); }, -g, eta,
+                                 opt.max_pcg_iterations, d, info.pcg_iterations);
       info.t_solve = since(t0);
       res.pcg_iterations += info.pcg_iterations;
     }
@@ -152,55 +178,11 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
     H.scatter_add(d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
-    const double full_step = dx.rowwise().norm().maxCoeff();
-    if (full_step <= opt.step_tolerance) {
-      res.reason = StopReason::StepTolerance;
-      res.converged = true;
-      break;
-    }
-
-    t0 = Clock::now();
-    const LineSearchResult ls =
-        backtracking_line_search(energy, x, dx, E, g.dot(d), n_inv, tets_, line_search_options(opt), x_trial);
-    info.t_line_search = since(t0);
-    res.t_assembly += info.t_assembly;
-    res.t_factorization += info.t_factorization;
-    res.t_solve += info.t_solve;
-    res.t_line_search += info.t_line_search;
-    if (!ls.accepted) {
-      res.reason = StopReason::LineSearchFailed;
-      break;
-    }
-    x.swap(x_trial);
-    E = ls.energy;
-    n_inv = ls.inverted;
+    if (apply_newton_step(energy, tets_, opt, dx, g.dot(d), x, x_trial, E, n_inv, info, res) != StepOutcome::Taken) break;
     g = H.gather(energy.gradient(x));
-
-    info.energy = E;
     info.gradient_norm = g.norm();
-    info.alpha = ls.alpha;
-    info.step_norm = ls.alpha * full_step;
-    info.inverted = n_inv;
     info.elapsed = since(t_start);
-    res.iterations = it;
-    res.energy = E;
-    res.gradient_norm = info.gradient_norm;
-    res.inverted = n_inv;
-    res.history.push_back(info);
-    if (opt.callback && !opt.callback(info)) {
-      res.reason = StopReason::Aborted;
-      break;
-    }
-    if (info.gradient_norm <= g_tol) {
-      res.reason = StopReason::GradientTolerance;
-      res.converged = true;
-      break;
-    }
-    if (info.step_norm <= opt.step_tolerance) {
-      res.reason = StopReason::StepTolerance;
-      res.converged = true;
-      break;
-    }
+    if (record_iteration(info, opt, g_tol, res)) break;
   }
   res.energy = E;
   res.gradient_norm = g.norm();

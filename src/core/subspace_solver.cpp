@@ -6,6 +6,7 @@
 
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/line_search.h"
+#include "breast_tumour_registration/core/pcg.h"
 #include "breast_tumour_registration/core/tet_kinematics.h"
 
 namespace btr {
@@ -63,33 +64,9 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
       const double eta = std::min(opt.max_forcing, std::sqrt(gr.norm() / std::max(res.initial_gradient_norm, 1e-300)));
       const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
       auto apply = [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(Ut * (Hs * (U * v))); };
-      const Eigen::VectorXd b = -gr;
-      d = ldlt.solve(b);
-      Eigen::VectorXd r = b - apply(d);
-      const double stop = eta * b.norm();
       int k = 0;
-      if (r.norm() <= stop) {
-        solved = true;
-      } else {
-        Eigen::VectorXd z = ldlt.solve(r), p = z;
-        double rz = r.dot(z);
-        for (k = 1; k <= opt.max_pcg_iterations; ++k) {
-          const Eigen::VectorXd Hp = apply(p);
-          const double pHp = p.dot(Hp);
-          if (!(pHp > 0)) break;
-          const double a = rz / pHp;
-          d += a * p;
-          r -= a * Hp;
-          if (r.norm() <= stop) {
-            solved = d.allFinite();
-            break;
-          }
-          z = ldlt.solve(r);
-          const double rz_new = r.dot(z);
-          p = z + (rz_new / rz) * p;
-          rz = rz_new;
-        }
-      }
+      solved = preconditioned_cg(apply, [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(ldlt.solve(v)); }, -gr,
+                                 eta, opt.max_pcg_iterations, d, k);
       info.pcg_iterations = k;
       res.pcg_iterations += k;
       info.t_solve = since(t0);
@@ -124,50 +101,11 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     H.scatter_add(U * d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
     info.t_solve = since(t0);
-    const double full_step = dx.rowwise().norm().maxCoeff();
-    if (full_step <= opt.step_tolerance) {
-      res.reason = StopReason::StepTolerance;
-      res.converged = true;
-      break;
-    }
-    t0 = Clock::now();
-    const LineSearchResult ls =
-        backtracking_line_search(energy, x, dx, E, gr.dot(d), n_inv, tets, line_search_options(opt), x_trial);
-    info.t_line_search = since(t0);
-    res.t_assembly += info.t_assembly;
-    res.t_factorization += info.t_factorization;
-    res.t_solve += info.t_solve;
-    res.t_line_search += info.t_line_search;
-    if (!ls.accepted) {
-      res.reason = StopReason::LineSearchFailed;
-      break;
-    }
-    x.swap(x_trial);
-    E = ls.energy;
-    n_inv = ls.inverted;
+    if (apply_newton_step(energy, tets, opt, dx, gr.dot(d), x, x_trial, E, n_inv, info, res) != StepOutcome::Taken) break;
     gr = Ut * H.gather(energy.gradient(x));
-    info.energy = E;
     info.gradient_norm = gr.norm();
-    info.alpha = ls.alpha;
-    info.step_norm = ls.alpha * full_step;
-    info.inverted = n_inv;
     info.elapsed = since(t_start);
-    res.iterations = it;
-    res.history.push_back(info);
-    if (opt.callback && !opt.callback(info)) {
-      res.reason = StopReason::Aborted;
-      break;
-    }
-    if (info.gradient_norm <= g_tol) {
-      res.reason = StopReason::GradientTolerance;
-      res.converged = true;
-      break;
-    }
-    if (info.step_norm <= opt.step_tolerance) {
-      res.reason = StopReason::StepTolerance;
-      res.converged = true;
-      break;
-    }
+    if (record_iteration(info, opt, g_tol, res)) break;
   }
   res.energy = E;
   res.gradient_norm = gr.norm();

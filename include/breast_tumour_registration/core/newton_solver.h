@@ -77,6 +77,21 @@ struct NewtonResult {
   std::vector<IterationInfo> history;
 };
 
+/// Records an accepted iteration in `res` (history, totals), calls the callback and applies
+/// the stopping rules; returns true when the solve should stop (reason and converged set).
+bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res);
+
+/// Outcome of trying a Newton direction.
+enum class StepOutcome { Taken, TooSmall, NoDecrease };
+
+/// Shared by the full-space and subspace solvers: takes the step dx (#V by 3) with the line
+/// search from x (energy E, n_inv inverted tetrahedra), updating x, E, n_inv, the iteration's
+/// alpha / step norm / line-search time and the result's time totals. TooSmall: the full step
+/// is below the step tolerance (converged); NoDecrease: the line search found no decrease.
+StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
+                              const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
+                              long& n_inv, IterationInfo& info, NewtonResult& res);
+
 /// The line-search part of the options.
 LineSearchOptions line_search_options(const NewtonOptions& opt);
 
