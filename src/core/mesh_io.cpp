@@ -133,13 +133,16 @@ void add_polygon(std::vector<Eigen::Vector3i>& tris, const std::vector<int>& pol
   for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
 }
 
+// Set by read_point_cloud: vertices without faces are then acceptable.
+thread_local bool g_points_only = false;
+
 SurfaceMesh finish(const std::string& path, const std::vector<Vec3>& verts,
                    const std::vector<Eigen::Vector3i>& tris, double scale) {
   SurfaceMesh m;
   m.V = to_points(verts, scale);
   m.F.resize(tris.size(), 3);
   for (size_t i = 0; i < tris.size(); ++i) m.F.row(i) = tris[i].transpose();
-  if (m.F.rows() == 0) throw InputError(path + ": no faces");
+  if (m.F.rows() == 0 && !g_points_only) throw InputError(path + ": no faces");
   check_indices(path, m.F, m.V.rows(), "face");
   return m;
 }
@@ -597,6 +600,32 @@ void write_surface(const std::string& path, const SurfaceMesh& mesh, LengthUnit 
   if (ext == ".stl") return write_stl(path, mesh, inv);
   if (ext == ".ply") return write_ply(path, mesh, inv);
   throw InputError("'" + path + "': unknown surface format '" + ext + "' (expected .obj, .ply, .stl or .off)");
+}
+
+Points read_point_cloud(const std::string& path, LengthUnit unit) {
+  const std::string ext = file_extension(path);
+  Points P;
+  if (ext == ".xyz" || ext == ".txt") {
+    TokenStream ts(path, true);
+    std::vector<Vec3> v;
+    while (!ts.done()) {
+      Vec3 p;
+      for (int c = 0; c < 3; ++c) p[c] = ts.next_double("coordinate");
+      v.push_back(p);
+    }
+    P = to_points(v, metres_per_unit(unit));
+  } else if (ext == ".ply" || ext == ".obj") {
+    struct Guard {
+      Guard() { g_points_only = true; }
+      ~Guard() { g_points_only = false; }
+    } guard;
+    P = read_surface(path, unit).V;
+  } else {
+    throw InputError("'" + path + "': unknown point cloud format '" + ext + "' (expected .xyz, .txt, .ply or .obj)");
+  }
+  if (P.rows() == 0) throw InputError(path + ": no points");
+  if (!P.allFinite()) throw InputError(path + ": NaN or infinite coordinates");
+  return P;
 }
 
 TetMesh read_tet_mesh(const std::string& path, LengthUnit unit) {

@@ -79,8 +79,9 @@ PlannedSteps plan_steps(const Scene& s) {
     if (!have_lm) throw InputError(where + "'landmarks' needs the field 'landmarks'");
     p.landmarks = true;
   }
-  if (auto_steps ? bool(s.supine_surface) : requested(s, "surface")) {
-    if (!s.supine_surface) throw InputError(where + "'surface' needs the field 'supine.surface'");
+  const bool have_supine = s.supine_surface || s.supine_cloud;
+  if (auto_steps ? have_supine : requested(s, "surface")) {
+    if (!have_supine) throw InputError(where + "'surface' needs the field 'supine.surface' or 'supine.cloud'");
     p.surface = true;
   }
   if (!p.rigid_landmarks && !p.rigid_icp && !p.gravity && !p.landmarks && !p.surface)
@@ -159,7 +160,9 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   r.rigid_seconds = since(t0);
   Points targets = scene.landmark_supine.rows() ? transform_points(T, scene.landmark_supine) : Points();
   std::optional<SurfaceMesh> supine_surface;
+  std::optional<Points> supine_cloud;
   if (scene.supine_surface) supine_surface = transform_surface(T, *scene.supine_surface);
+  else if (scene.supine_cloud) supine_cloud = transform_points(T, *scene.supine_cloud);
 
   // 2. Optional gravity pre-step (thesis Sec. 5.2.2: gravity + surface).
   if (r.steps.gravity) {
@@ -187,7 +190,10 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   // 3. Landmark-guided step.
   if (r.steps.landmarks) r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback));
   // 4. Surface-guided step.
-  if (r.steps.surface) r.reports.push_back(surface_step(model, *supine_surface, opt.surface, r.x, callback));
+  if (r.steps.surface) {
+    const auto projector = supine_surface ? make_mesh_projector(*supine_surface) : make_cloud_projector(*supine_cloud);
+    r.reports.push_back(surface_step(model, *projector, opt.surface, r.x, callback));
+  }
   for (const auto& rep : r.reports) r.converged = r.converged && rep.converged;
   r.seconds = since(t_start);
 
@@ -221,10 +227,11 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     r.landmark_residual_mean = st.mean;
     r.landmark_residual_max = st.max;
   }
-  if (supine_surface) {
-    Points skin(model.skin.size(), 3);
-    for (size_t i = 0; i < model.skin.size(); ++i) skin.row(i) = r.x.row(model.skin[i]);
-    const DistanceStats st = distance_stats(point_to_surface_distances(skin, *supine_surface));
+  if (supine_surface || supine_cloud) {
+    const auto projector = supine_surface ? make_mesh_projector(*supine_surface) : make_cloud_projector(*supine_cloud);
+    std::vector<double> d;
+    for (int v : model.skin) d.push_back(projector->project(r.x.row(v).transpose()).distance);
+    const DistanceStats st = distance_stats(d);
     r.skin_distance_mean = st.mean;
     r.skin_distance_max = st.max;
   }

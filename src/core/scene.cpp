@@ -125,6 +125,10 @@ Scene load_scene(const std::string& path) {
       return m;
     });
   }
+  if (supine && supine["cloud"]) {
+    if (s.supine_surface) c.fail("supine.cloud", "give supine.surface or supine.cloud, not both");
+    s.supine_cloud = c.load("supine.cloud", [&] { return read_point_cloud(c.path_of(supine["cloud"], "supine.cloud"), s.units); });
+  }
   if (supine && supine["chest_ring"])
     s.supine_rigid = c.load("supine.chest_ring", [&] { return read_surface(c.path_of(supine["chest_ring"], "supine.chest_ring"), s.units); });
   if (root["chest_ring"])
@@ -218,6 +222,7 @@ Scene load_scene(const std::string& path) {
                                Eigen::AngleAxisd(rot.x(), Vec3::UnitX())).toRotationMatrix();
     s.misalignment.translation() = tr;
     if (s.supine_surface) s.supine_surface = transform_surface(s.misalignment, *s.supine_surface);
+    if (s.supine_cloud) s.supine_cloud = transform_points(s.misalignment, *s.supine_cloud);
     if (s.supine_rigid) s.supine_rigid = transform_surface(s.misalignment, *s.supine_rigid);
     if (s.landmark_supine.rows()) s.landmark_supine = transform_points(s.misalignment, s.landmark_supine);
     for (auto& t : s.tumours)

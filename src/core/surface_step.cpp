@@ -4,7 +4,6 @@
 #include <cmath>
 #include <memory>
 
-#include "breast_tumour_registration/core/closest_point.h"
 #include "breast_tumour_registration/core/elastic_energy.h"
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/gravity_energy.h"
@@ -13,14 +12,11 @@
 
 namespace btr {
 
-StepReport surface_step(const RegistrationModel& model, const SurfaceMesh& supine, const SurfaceStepOptions& opt,
+StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
                         Points& x, const StepCallback& callback) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (supine.F.rows() == 0) throw InputError("surface step: the supine surface has no faces");
-  if (!supine.V.allFinite()) throw InputError("surface step: the supine surface has NaN coordinates");
   if (opt.max_projections < 1 || opt.newton_per_projection < 1)
     throw InputError("surface step: max_projections and newton_per_projection must be >= 1");
-  const SurfaceClosestPoint cp(supine.V, supine.F);
 
   TotalEnergy energy;
   energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
@@ -47,14 +43,14 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceMesh& supin
     int kept = 0;
     for (size_t i = 0; i < model.skin.size(); ++i) {
       const int v = model.skin[i];
-      const ClosestPoint c = cp.query(x.row(v).transpose());
+      const Projection c = supine.project(x.row(v).transpose());
       const double m = (c.point - targets.row(i).transpose()).norm();
       moved = std::max(moved, m);
       moved_sq += m * m;
       targets.row(i) = c.point.transpose();
       if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) continue;
       points->add(Anchor::vertex(v), c.point);
-      planes->add(Anchor::vertex(v), c.point, cp.face_normal(c.face));
+      planes->add(Anchor::vertex(v), c.point, c.normal);
       ++kept;
     }
     const double moved_rms = std::sqrt(moved_sq / static_cast<double>(model.skin.size()));

@@ -228,8 +228,18 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       if (tracked < params_.min_tracked_clouds)
         throw InputError("the depth tracking is settling (" + std::to_string(tracked) + " of " +
                          std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
-      if (w == 0) throw InputError("the latest cloud is not organized; the surface step needs an organized depth image");
-      scene.supine_surface = triangulate_organized(cloud, w, h, params_.max_depth_edge);
+      if (w > 0) {
+        scene.supine_surface = triangulate_organized(cloud, w, h, params_.max_depth_edge);
+      } else {
+        // Unorganized cloud: project onto the points themselves (PCA normals).
+        Points finite(cloud.rows(), 3);
+        Eigen::Index k = 0;
+        for (Eigen::Index i = 0; i < cloud.rows(); ++i)
+          if (cloud.row(i).allFinite()) finite.row(k++) = cloud.row(i);
+        finite.conservativeResize(k, 3);
+        scene.supine_surface.reset();
+        scene.supine_cloud = finite;
+      }
       // The scene's supine data (landmarks, ground truth) is in the model's supine frame:
       // place it in the working frame with the tracked alignment.
       if (params_.use_landmarks && scene.landmark_supine.rows()) scene.landmark_supine = transform_points(*T, scene.landmark_supine);

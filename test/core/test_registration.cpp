@@ -346,3 +346,24 @@ TEST(StiffTumour, KeepsTheTumourShapeCloserToTheTruth) {
   for (size_t i = 0; i < stiff.tumours.size(); ++i)
     EXPECT_GT(stiff.tumours[i].axis_ratio, homogeneous.tumours[i].axis_ratio) << "homogeneous material flattens more";
 }
+
+TEST(Registration, SupinePointCloudInsteadOfASurface) {
+  // The supine scan as unorganized points (e.g. from a depth camera or a laser scanner).
+  const Scene base = load_scene(phantom_dir() + "/scene.yaml");
+  std::ofstream xyz(phantom_dir() + "/supine_points.xyz");
+  xyz << "# x y z [mm]\n";
+  for (Eigen::Index i = 0; i < base.supine_surface->V.rows(); ++i)
+    xyz << base.supine_surface->V(i, 0) * 1e3 << ' ' << base.supine_surface->V(i, 1) * 1e3 << ' '
+        << base.supine_surface->V(i, 2) * 1e3 << '\n';
+  xyz.close();
+  const std::string path = scene_with("supine:\n  cloud: supine_points.xyz\n  chest_ring: chest_ring.obj", "cloud_scene");
+  const Scene s = load_scene(path);
+  ASSERT_TRUE(s.supine_cloud);
+  EXPECT_FALSE(s.supine_surface);
+  EXPECT_EQ(s.supine_cloud->rows(), base.supine_surface->V.rows());
+  const RegistrationResult r = register_scene(path);
+  EXPECT_TRUE(r.steps.surface);
+  EXPECT_LT(worst_error(r), 0.5e-3);
+  expect_throw_with<InputError>([&] { read_point_cloud(phantom_dir() + "/nothing.pcd", LengthUnit::Millimetre); },
+                                "unknown point cloud format");
+}

@@ -18,6 +18,10 @@ SurfaceMesh read_surface(const std::string& path, LengthUnit unit);
 /// Writes a triangle surface; the format follows the extension (.obj .ply .stl .off).
 void write_surface(const std::string& path, const SurfaceMesh& mesh, LengthUnit unit);
 
+/// Reads the points of a cloud: .xyz / .txt (x y z per line, '#' comments), or the vertices of
+/// a .ply or .obj (faces, if any, are ignored). Throws InputError for no points or NaN.
+Points read_point_cloud(const std::string& path, LengthUnit unit);
+
 /// Reads a tetrahedral mesh from legacy VTK (.vtk, ASCII unstructured grid,
 /// cell type 10) or Medit (.mesh). Non-tetrahedral cells are an error.
 TetMesh read_tet_mesh(const std::string& path, LengthUnit unit);

@@ -10,6 +10,7 @@
 //   landmarks: landmarks.csv       # optional: prone index with supine index or supine x,y,z
 //   supine:
 //     surface: supine.obj          # optional: supine surface (closed mesh or open scan)
+//     cloud: scan.xyz              # optional instead of surface: unorganized points (.xyz, .ply, .obj)
 //     chest_ring: ring.obj         # optional: supine rigid region (for ICP)
 //   tumours: [{name: t1, prone: t1.obj, supine_ground_truth: t1_supine.obj}]
 //   material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}
@@ -47,6 +48,7 @@ struct Scene {
   std::vector<Anchor> landmark_anchors;  ///< prone landmark points
   Points landmark_supine;                ///< supine landmark positions (supine frame), one row per anchor
   std::optional<SurfaceMesh> supine_surface;  ///< supine frame
+  std::optional<Points> supine_cloud;         ///< supine frame; used when there is no supine_surface
   std::optional<SurfaceMesh> prone_rigid;     ///< model frame
   std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
   std::vector<SceneTumour> tumours;

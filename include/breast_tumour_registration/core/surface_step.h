@@ -7,6 +7,7 @@
 #pragma once
 
 #include "breast_tumour_registration/core/registration_model.h"
+#include "breast_tumour_registration/core/surface_projector.h"
 
 namespace btr {
 
@@ -27,9 +28,9 @@ struct SurfaceStepOptions {
   NewtonOptions newton;
 };
 
-/// supine: the supine surface in the model frame (closed or open, e.g. a scan).
-/// x: current positions, updated in place. Throws InputError for an empty surface.
-StepReport surface_step(const RegistrationModel& model, const SurfaceMesh& supine, const SurfaceStepOptions& opt,
+/// supine: projection onto the supine surface in the model frame (a mesh, closed or open,
+/// or a point cloud). x: current positions, updated in place.
+StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
                         Points& x, const StepCallback& callback = {});
 
 }  // namespace btr
