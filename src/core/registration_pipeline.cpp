@@ -159,10 +159,11 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   r.supine_to_model = T;
   r.rigid_seconds = since(t0);
   Points targets = scene.landmark_supine.rows() ? transform_points(T, scene.landmark_supine) : Points();
-  std::optional<SurfaceMesh> supine_surface;
-  std::optional<Points> supine_cloud;
-  if (scene.supine_surface) supine_surface = transform_surface(T, *scene.supine_surface);
-  else if (scene.supine_cloud) supine_cloud = transform_points(T, *scene.supine_cloud);
+  // The supine surface in the model frame, as a projector (AABB tree or kd-tree + normals),
+  // built once for the surface step and the skin-distance figure.
+  std::unique_ptr<SurfaceProjector> supine;
+  if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface));
+  else if (scene.supine_cloud) supine = make_cloud_projector(transform_points(T, *scene.supine_cloud));
 
   // 2. Optional gravity pre-step (thesis Sec. 5.2.2: gravity + surface).
   if (r.steps.gravity) {
@@ -190,10 +191,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   // 3. Landmark-guided step.
   if (r.steps.landmarks) r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback));
   // 4. Surface-guided step.
-  if (r.steps.surface) {
-    const auto projector = supine_surface ? make_mesh_projector(*supine_surface) : make_cloud_projector(*supine_cloud);
-    r.reports.push_back(surface_step(model, *projector, opt.surface, r.x, callback));
-  }
+  if (r.steps.surface) r.reports.push_back(surface_step(model, *supine, opt.surface, r.x, callback));
   for (const auto& rep : r.reports) r.converged = r.converged && rep.converged;
   r.seconds = since(t_start);
 
@@ -227,10 +225,9 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     r.landmark_residual_mean = st.mean;
     r.landmark_residual_max = st.max;
   }
-  if (supine_surface || supine_cloud) {
-    const auto projector = supine_surface ? make_mesh_projector(*supine_surface) : make_cloud_projector(*supine_cloud);
+  if (supine) {
     std::vector<double> d;
-    for (int v : model.skin) d.push_back(projector->project(r.x.row(v).transpose()).distance);
+    for (int v : model.skin) d.push_back(supine->project(r.x.row(v).transpose()).distance);
     const DistanceStats st = distance_stats(d);
     r.skin_distance_mean = st.mean;
     r.skin_distance_max = st.max;
