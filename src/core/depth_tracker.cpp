@@ -36,6 +36,24 @@ DepthTracker::DepthTracker(Points rigid_region, const Rigid& initial, const Dept
   }
 }
 
+Points to_working_frame(Points& cloud, const Rigid& sensor_to_working, const Vec3& roi_min, const Vec3& roi_max) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Points finite(cloud.rows(), 3);
+  Eigen::Index k = 0;
+  for (Eigen::Index i = 0; i < cloud.rows(); ++i) {
+    if (!cloud.row(i).allFinite()) continue;
+    const Vec3 p = sensor_to_working * Vec3(cloud.row(i).transpose());
+    if ((p.array() < roi_min.array()).any() || (p.array() > roi_max.array()).any()) {
+      cloud.row(i).setConstant(nan);
+      continue;
+    }
+    cloud.row(i) = p.transpose();
+    finite.row(k++) = p.transpose();
+  }
+  finite.conservativeResize(k, 3);
+  return finite;
+}
+
 Points rigid_region_clear_of(const Points& region, const SurfaceMesh& skin, double margin) {
   const std::vector<double> d = point_to_surface_distances(region, skin);
   Points out(region.rows(), 3);
@@ -57,20 +75,8 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
   using Clock = std::chrono::steady_clock;
   TrackingResult r;
   auto t0 = Clock::now();
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  Points finite(cloud.rows(), 3);
-  Eigen::Index k = 0;
-  for (Eigen::Index i = 0; i < cloud.rows(); ++i) {
-    if (!cloud.row(i).allFinite()) continue;
-    const Vec3 p = sensor_to_working * Vec3(cloud.row(i).transpose());
-    if ((p.array() < opt_.roi_min.array()).any() || (p.array() > opt_.roi_max.array()).any()) {
-      cloud.row(i).setConstant(nan);
-      continue;
-    }
-    cloud.row(i) = p.transpose();
-    finite.row(k++) = p.transpose();
-  }
-  finite.conservativeResize(k, 3);
+  Points finite = to_working_frame(cloud, sensor_to_working, opt_.roi_min, opt_.roi_max);
+  const Eigen::Index k = finite.rows();
   r.points_in_roi = k;
   if (pose_ && opt_.region_band > 0) {
     const Rigid to_model = guess_.inverse();

@@ -133,22 +133,20 @@ void add_polygon(std::vector<Eigen::Vector3i>& tris, const std::vector<int>& pol
   for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
 }
 
-// Set by read_point_cloud: vertices without faces are then acceptable.
-thread_local bool g_points_only = false;
-
+// require_faces is false only for point clouds read from mesh formats.
 SurfaceMesh finish(const std::string& path, const std::vector<Vec3>& verts,
-                   const std::vector<Eigen::Vector3i>& tris, double scale) {
+                   const std::vector<Eigen::Vector3i>& tris, double scale, bool require_faces) {
   SurfaceMesh m;
   m.V = to_points(verts, scale);
   m.F.resize(tris.size(), 3);
   for (size_t i = 0; i < tris.size(); ++i) m.F.row(i) = tris[i].transpose();
-  if (m.F.rows() == 0 && !g_points_only) throw InputError(path + ": no faces");
+  if (m.F.rows() == 0 && require_faces) throw InputError(path + ": no faces");
   check_indices(path, m.F, m.V.rows(), "face");
   return m;
 }
 
 // ---------------------------------------------------------------- OBJ
-SurfaceMesh read_obj(const std::string& path, double scale) {
+SurfaceMesh read_obj(const std::string& path, double scale, bool require_faces) {
   auto in = open_in(path);
   std::vector<Vec3> verts;
   std::vector<Eigen::Vector3i> tris;
@@ -176,7 +174,7 @@ SurfaceMesh read_obj(const std::string& path, double scale) {
       add_polygon(tris, poly, path, ln);
     }
   }
-  return finish(path, verts, tris, scale);
+  return finish(path, verts, tris, scale, require_faces);
 }
 
 void write_obj(const std::string& path, const SurfaceMesh& m, double inv) {
@@ -189,7 +187,7 @@ void write_obj(const std::string& path, const SurfaceMesh& m, double inv) {
 }
 
 // ---------------------------------------------------------------- OFF
-SurfaceMesh read_off(const std::string& path, double scale) {
+SurfaceMesh read_off(const std::string& path, double scale, bool require_faces) {
   TokenStream ts(path, true);
   if (ts.done() || lower(ts.peek().text).find("off") == std::string::npos) throw InputError(path + ": missing OFF header");
   ts.next("header");
@@ -213,7 +211,7 @@ SurfaceMesh read_off(const std::string& path, double scale) {
     add_polygon(tris, poly, path, line);
     ts.skip_rest_of_line(line);  // optional per-face colour
   }
-  return finish(path, verts, tris, scale);
+  return finish(path, verts, tris, scale, require_faces);
 }
 
 void write_off(const std::string& path, const SurfaceMesh& m, double inv) {
@@ -237,7 +235,7 @@ struct VertexMerger {
   }
 };
 
-SurfaceMesh read_stl(const std::string& path, double scale) {
+SurfaceMesh read_stl(const std::string& path, double scale, bool require_faces) {
   auto in = open_in(path, true);
   std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (content.size() < 15) throw InputError(path + ": file too short to be STL");
@@ -293,7 +291,7 @@ SurfaceMesh read_stl(const std::string& path, double scale) {
       }
     }
   }
-  return finish(path, merge.verts, tris, scale);
+  return finish(path, merge.verts, tris, scale, require_faces);
 }
 
 void write_stl(const std::string& path, const SurfaceMesh& m, double inv) {
@@ -354,7 +352,7 @@ double ply_read_binary(const char*& p, const char* end, const std::string& t, co
   return v;
 }
 
-SurfaceMesh read_ply(const std::string& path, double scale) {
+SurfaceMesh read_ply(const std::string& path, double scale, bool require_faces) {
   auto in = open_in(path, true);
   std::string content((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const size_t hdr_end = content.find("end_header");
@@ -419,7 +417,7 @@ SurfaceMesh read_ply(const std::string& path, double scale) {
       if (e.name == "face") add_polygon(tris, poly, path, 0);
     }
   }
-  return finish(path, verts, tris, scale);
+  return finish(path, verts, tris, scale, require_faces);
 }
 
 void write_ply(const std::string& path, const SurfaceMesh& m, double inv) {
@@ -585,10 +583,10 @@ std::string file_extension(const std::string& path) {
 SurfaceMesh read_surface(const std::string& path, LengthUnit unit) {
   const std::string ext = file_extension(path);
   const double s = metres_per_unit(unit);
-  if (ext == ".obj") return read_obj(path, s);
-  if (ext == ".off") return read_off(path, s);
-  if (ext == ".stl") return read_stl(path, s);
-  if (ext == ".ply") return read_ply(path, s);
+  if (ext == ".obj") return read_obj(path, s, true);
+  if (ext == ".off") return read_off(path, s, true);
+  if (ext == ".stl") return read_stl(path, s, true);
+  if (ext == ".ply") return read_ply(path, s, true);
   throw InputError("'" + path + "': unknown surface format '" + ext + "' (expected .obj, .ply, .stl or .off)");
 }
 
@@ -614,12 +612,10 @@ Points read_point_cloud(const std::string& path, LengthUnit unit) {
       v.push_back(p);
     }
     P = to_points(v, metres_per_unit(unit));
-  } else if (ext == ".ply" || ext == ".obj") {
-    struct Guard {
-      Guard() { g_points_only = true; }
-      ~Guard() { g_points_only = false; }
-    } guard;
-    P = read_surface(path, unit).V;
+  } else if (ext == ".ply") {
+    P = read_ply(path, metres_per_unit(unit), false).V;
+  } else if (ext == ".obj") {
+    P = read_obj(path, metres_per_unit(unit), false).V;
   } else {
     throw InputError("'" + path + "': unknown point cloud format '" + ext + "' (expected .xyz, .txt, .ply or .obj)");
   }

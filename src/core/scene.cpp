@@ -70,7 +70,6 @@ Scene load_scene(const std::string& path) {
   Scene s;
   s.path = path;
   if (root["units"]) s.units = c.load("units", [&] { return parse_length_unit(root["units"].as<std::string>()); });
-  const double m_per_unit = metres_per_unit(s.units);
 
   // Prone model.
   const YAML::Node prone = root["prone"];
@@ -228,7 +227,6 @@ Scene load_scene(const std::string& path) {
     for (auto& t : s.tumours)
       if (t.supine_ground_truth) t.supine_ground_truth = transform_surface(s.misalignment, *t.supine_ground_truth);
   }
-  (void)m_per_unit;
   return s;
 }
 

@@ -152,19 +152,11 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       r = tracker_->process(c.points, T);
     } else {
       // Keep the cloud in the working frame (ROI applied) without aligning it.
-      for (Eigen::Index i = 0; i < c.points.rows(); ++i) {
-        if (!c.points.row(i).allFinite()) continue;
-        const Vec3 p = T * Vec3(c.points.row(i).transpose());
-        if ((p.array() < params_.roi_min.array()).any() || (p.array() > params_.roi_max.array()).any())
-          c.points.row(i).setConstant(std::numeric_limits<double>::quiet_NaN());
-        else
-          c.points.row(i) = p.transpose();
-      }
+      to_working_frame(c.points, T, params_.roi_min, params_.roi_max);
     }
     latest_cloud_ = std::move(c.points);
     latest_width_ = c.organized ? c.width : 0;
     latest_height_ = c.organized ? c.height : 0;
-    latest_stamp_ = msg->header.stamp;
     have_cloud_ = true;
     ++clouds_seen_;
     if (!track) return;

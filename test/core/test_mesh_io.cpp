@@ -150,3 +150,17 @@ TEST(IndexIo, LandmarkPairsWithVertexOrPointTargets) {
   write_text(dir + "/bad.csv", "3,7\n4,9,1\n");
   expect_throw_with<InputError>([&] { read_landmark_pairs(dir + "/bad.csv", LengthUnit::Metre); }, "bad.csv:2: expected");
 }
+
+TEST(PointCloudIo, VertexOnlyPlyAndObjAreCloudsButNotSurfaces) {
+  const std::string dir = temp_dir();
+  write_text(dir + "/pts.obj", "v 0 0 0\nv 10 0 0\nv 0 20 0\nv 0 0 30\n");
+  write_text(dir + "/pts.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                               "property float z\nend_header\n1 2 3\n4 5 6\n");
+  const Points a = read_point_cloud(dir + "/pts.obj", LengthUnit::Millimetre);
+  ASSERT_EQ(a.rows(), 4);
+  EXPECT_DOUBLE_EQ(a(3, 2), 0.030);
+  const Points b = read_point_cloud(dir + "/pts.ply", LengthUnit::Metre);
+  ASSERT_EQ(b.rows(), 2);
+  EXPECT_DOUBLE_EQ(b(1, 0), 4.0);
+  expect_throw_with<InputError>([&] { read_surface(dir + "/pts.obj", LengthUnit::Millimetre); }, "no faces");
+}

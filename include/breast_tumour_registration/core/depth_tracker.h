@@ -33,6 +33,11 @@ struct TrackingResult {
   double seconds_icp = 0;     ///< downsampling, normals and ICP
 };
 
+/// Moves the finite points of `cloud` (sensor frame, NaN allowed, layout kept) into the
+/// working frame in place, sets those outside [roi_min, roi_max] to NaN, and returns the
+/// remaining finite points (working frame).
+Points to_working_frame(Points& cloud, const Rigid& sensor_to_working, const Vec3& roi_min, const Vec3& roi_max);
+
 /// The part of a rigid region farther than `margin` [m] from the breast surface `skin`:
 /// the deforming breast bulges over the nearest part of the chest skin in a depth view, so
 /// tracking on it would be biased. Throws InputError if fewer than 6 points remain.

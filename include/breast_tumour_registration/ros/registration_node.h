@@ -69,7 +69,6 @@ class RegistrationNode {
   Points latest_cloud_;
   int latest_width_ = 0, latest_height_ = 0;
   bool have_cloud_ = false;
-  ros::Time latest_stamp_;
   std::optional<DepthTracker> tracker_;
   Points tracked_region_;  ///< the rigid region clear of the breast (model frame)
   long clouds_seen_ = 0;
