@@ -68,6 +68,34 @@ void write_index_list(const std::string& path, const std::vector<int>& indices) 
   out << '\n';
 }
 
+std::vector<std::pair<std::string, int>> read_named_indices(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("cannot open named vertex file '" + path + "': file missing or unreadable");
+  std::vector<std::pair<std::string, int>> out;
+  std::string line;
+  size_t ln = 0;
+  while (std::getline(in, line)) {
+    ++ln;
+    const auto f = split_fields(line);
+    if (f.empty()) continue;
+    long v = 0;
+    if (f.size() != 2 || !parse_int(f[1], v) || v < 0)
+      throw InputError(path + ":" + std::to_string(ln) + ": expected 'name vertex_index', got '" + line + "'");
+    for (const auto& [name, index] : out)
+      if (name == f[0]) throw InputError(path + ":" + std::to_string(ln) + ": name '" + f[0] + "' given twice");
+    out.emplace_back(f[0], static_cast<int>(v));
+  }
+  if (out.empty()) throw InputError(path + ": no named vertices");
+  return out;
+}
+
+void write_named_indices(const std::string& path, const std::vector<std::pair<std::string, int>>& named) {
+  std::ofstream out(path);
+  if (!out) throw InputError("cannot write '" + path + "'");
+  out << "# name vertex_index (0-based)\n";
+  for (const auto& [name, index] : named) out << name << ' ' << index << '\n';
+}
+
 std::vector<LandmarkPair> read_landmark_pairs(const std::string& path, LengthUnit unit) {
   std::ifstream in(path);
   if (!in) throw InputError("cannot open landmark file '" + path + "': file missing or unreadable");

@@ -11,9 +11,47 @@
 #include "breast_tumour_registration/core/index_io.h"
 #include "breast_tumour_registration/core/mesh_io.h"
 #include "breast_tumour_registration/core/metrics.h"
+#include "breast_tumour_registration/core/rest_model_io.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 
 namespace btr {
+
+PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomSceneOptions& opt,
+                                       const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
+  StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio);  // validates before the expensive steps
+  std::vector<int> inclusion;
+  if (opt.tumour_youngs_modulus > 0) {
+    std::vector<const SurfaceMesh*> tumours;
+    for (const auto& [name, t] : model.tumours) tumours.push_back(&t);
+    inclusion = tetrahedra_inside(model.rest, tumours);
+  }
+  auto solve = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
+    GravityProblem pb;
+    pb.rest = &model.rest;
+    pb.fixed = model.chest_wall;
+    pb.youngs_modulus = opt.youngs_modulus;
+    pb.poisson_ratio = opt.poisson_ratio;
+    pb.density = opt.density;
+    pb.gravity = g;
+    pb.inclusion = inclusion;
+    pb.inclusion_youngs_modulus = opt.tumour_youngs_modulus;
+    NewtonOptions newton;
+    if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
+    GravityResult r = solve_gravity(pb, newton);
+    if (!r.newton.converged) throw SolverError(name + " solve did not converge: " + to_string(r.newton.reason));
+    out = r.newton;
+    return r.x;
+  };
+  PhantomConfigurations c;
+  c.prone = solve("prone", Vec3(0, 0, 9.81), c.prone_newton);
+  c.supine = solve("supine", Vec3(0, 0, -9.81), c.supine_newton);
+  for (const auto& [name, t] : model.tumours) {
+    const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
+    c.tumour_prone[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.prone), t.F};
+    c.tumour_supine[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.supine), t.F};
+  }
+  return c;
+}
 
 PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSceneOptions& opt,
                                         const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
@@ -27,37 +65,15 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   sum.tetrahedra = model.rest.T.rows();
   sum.chest_wall_vertices = static_cast<long>(model.chest_wall.size());
   sum.quality = tet_quality(model.rest);
-
-  auto solve = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
-    GravityProblem pb;
-    pb.rest = &model.rest;
-    pb.fixed = model.chest_wall;
-    pb.youngs_modulus = opt.youngs_modulus;
-    pb.poisson_ratio = opt.poisson_ratio;
-    pb.density = opt.density;
-    pb.gravity = g;
-    if (opt.tumour_youngs_modulus > 0) {
-      std::vector<const SurfaceMesh*> tumours;
-      for (const auto& [name, t] : model.tumours) tumours.push_back(&t);
-      pb.inclusion = tetrahedra_inside(model.rest, tumours);
-      pb.inclusion_youngs_modulus = opt.tumour_youngs_modulus;
-    }
-    NewtonOptions newton;
-    if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
-    GravityResult r = solve_gravity(pb, newton);
-    if (!r.newton.converged) throw SolverError(name + " solve did not converge: " + to_string(r.newton.reason));
-    out = r.newton;
-    return r.x;
-  };
-  const Points prone = solve("prone", Vec3(0, 0, 9.81), sum.prone);
-  const Points supine = solve("supine", Vec3(0, 0, -9.81), sum.supine);
+  const PhantomConfigurations conf = simulate_phantom(model, opt, progress);
+  sum.prone = conf.prone_newton;
+  sum.supine = conf.supine_newton;
+  const Points& prone = conf.prone;
+  const Points& supine = conf.supine;
 
   auto path = [&](const std::string& f) { return (fs::path(dir) / f).string(); };
   const LengthUnit unit = opt.units;
-  write_surface(path("rest_surface.obj"), model.surface, unit);
-  write_tet_mesh(path("rest.vtk"), model.rest, unit);
-  write_index_list(path("chest_wall.txt"), model.chest_wall);
-  write_surface(path("chest_ring.obj"), model.chest_ring, unit);
+  write_rest_model(dir, model, unit);  // rest.vtk, chest_wall.txt, chest_ring.obj, tumours, model.yaml
   TetMesh m = model.rest;
   m.V = prone;
   write_tet_mesh(path("prone.vtk"), m, unit);
@@ -79,11 +95,8 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
 
   YAML::Node tumours;
   for (const auto& name : phantom_tumour_names()) {
-    const SurfaceMesh& t = model.tumours.at(name);
-    const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
-    const SurfaceMesh tp{apply_embedding(emb, model.rest.T, prone), t.F};
-    const SurfaceMesh ts{apply_embedding(emb, model.rest.T, supine), t.F};
-    write_surface(path("tumour_" + name + "_rest.obj"), t, unit);
+    const SurfaceMesh& tp = conf.tumour_prone.at(name);
+    const SurfaceMesh& ts = conf.tumour_supine.at(name);
     write_surface(path("tumour_" + name + "_prone.obj"), tp, unit);
     write_surface(path("tumour_" + name + "_supine.obj"), ts, unit);
     YAML::Node n;

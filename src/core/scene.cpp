@@ -12,61 +12,33 @@
 #include "breast_tumour_registration/core/surface_attachment.h"
 #include "breast_tumour_registration/core/tetrahedralize.h"
 #include "breast_tumour_registration/core/validation.h"
+#include "breast_tumour_registration/core/yaml_fields.h"
 
 namespace btr {
-namespace {
-
 namespace fs = std::filesystem;
 
-struct Ctx {
-  std::string file;
-  fs::path dir;
-  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
-    throw InputError(file + ": field '" + field + "': " + what);
-  }
-  std::string path_of(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) fail(field, "expected a file name");
-    const fs::path p(n.as<std::string>());
-    return (p.is_absolute() ? p : dir / p).string();
-  }
-  double number(const YAML::Node& n, const std::string& field) const {
-    try {
-      return n.as<double>();
-    } catch (const YAML::Exception&) {
-      fail(field, "expected a number");
-    }
-  }
-  Vec3 vec3(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsSequence() || n.size() != 3) fail(field, "expected a list of 3 numbers");
-    Vec3 v;
-    for (int i = 0; i < 3; ++i) v[i] = number(n[i], field);
-    if (!v.allFinite()) fail(field, "values must be finite");
-    return v;
-  }
-  // Runs a loader and prefixes its error with the field name.
-  template <class F>
-  auto load(const std::string& field, F&& f) const -> decltype(f()) {
-    try {
-      return f();
-    } catch (const InputError& e) {
-      fail(field, e.what());
-    }
-  }
-};
+Rigid misalignment_from_degrees_mm(const Vec3& rotation_deg, const Vec3& translation_mm) {
+  const Vec3 rot = rotation_deg * M_PI / 180.0;
+  Rigid m = Rigid::Identity();
+  m.linear() = (Eigen::AngleAxisd(rot.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rot.y(), Vec3::UnitY()) *
+                Eigen::AngleAxisd(rot.x(), Vec3::UnitX())).toRotationMatrix();
+  m.translation() = translation_mm * 1e-3;
+  return m;
+}
 
-}  // namespace
+void apply_misalignment(Scene& s, const Rigid& m) {
+  if (s.supine_surface) s.supine_surface = transform_surface(m, *s.supine_surface);
+  if (s.supine_cloud) s.supine_cloud = transform_points(m, *s.supine_cloud);
+  if (s.supine_rigid) s.supine_rigid = transform_surface(m, *s.supine_rigid);
+  if (s.landmark_supine.rows()) s.landmark_supine = transform_points(m, s.landmark_supine);
+  for (auto& t : s.tumours)
+    if (t.supine_ground_truth) t.supine_ground_truth = transform_surface(m, *t.supine_ground_truth);
+  s.misalignment = m * s.misalignment;
+}
 
 Scene load_scene(const std::string& path) {
-  Ctx c{path, fs::path(path).parent_path()};
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw InputError("cannot open scene '" + path + "': file missing or unreadable");
-  } catch (const YAML::Exception& e) {
-    throw InputError(path + ": YAML syntax error: " + e.what());
-  }
-  if (!root.IsMap()) throw InputError(path + ": a scene is a YAML mapping of fields");
+  const YamlFields c{path, fs::path(path).parent_path()};
+  const YAML::Node root = YamlFields::load_mapping(path, "scene");
   Scene s;
   s.path = path;
   if (root["units"]) s.units = c.load("units", [&] { return parse_length_unit(root["units"].as<std::string>()); });
@@ -214,18 +186,9 @@ Scene load_scene(const std::string& path) {
   // Simulated misalignment of the supine data (experiments of thesis Sec. 5.2.5).
   if (const YAML::Node mis = root["misalignment"]) {
     Vec3 rot = Vec3::Zero(), tr = Vec3::Zero();
-    if (mis["rotation_deg"]) rot = c.vec3(mis["rotation_deg"], "misalignment.rotation_deg") * M_PI / 180.0;
-    if (mis["translation_mm"]) tr = c.vec3(mis["translation_mm"], "misalignment.translation_mm") * 1e-3;
-    s.misalignment = Rigid::Identity();
-    s.misalignment.linear() = (Eigen::AngleAxisd(rot.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rot.y(), Vec3::UnitY()) *
-                               Eigen::AngleAxisd(rot.x(), Vec3::UnitX())).toRotationMatrix();
-    s.misalignment.translation() = tr;
-    if (s.supine_surface) s.supine_surface = transform_surface(s.misalignment, *s.supine_surface);
-    if (s.supine_cloud) s.supine_cloud = transform_points(s.misalignment, *s.supine_cloud);
-    if (s.supine_rigid) s.supine_rigid = transform_surface(s.misalignment, *s.supine_rigid);
-    if (s.landmark_supine.rows()) s.landmark_supine = transform_points(s.misalignment, s.landmark_supine);
-    for (auto& t : s.tumours)
-      if (t.supine_ground_truth) t.supine_ground_truth = transform_surface(s.misalignment, *t.supine_ground_truth);
+    if (mis["rotation_deg"]) rot = c.vec3(mis["rotation_deg"], "misalignment.rotation_deg");
+    if (mis["translation_mm"]) tr = c.vec3(mis["translation_mm"], "misalignment.translation_mm");
+    apply_misalignment(s, misalignment_from_degrees_mm(rot, tr));
   }
   return s;
 }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "breast_tumour_registration/core/types.h"
@@ -25,6 +26,10 @@ struct LandmarkPair {
 /// (any line whose first field is not a number) and '#' comments are skipped.
 std::vector<LandmarkPair> read_landmark_pairs(const std::string& path, LengthUnit unit);
 void write_landmark_pairs(const std::string& path, const std::vector<LandmarkPair>& pairs, LengthUnit unit);
+
+/// Named vertices (e.g. landmarks C, O1, ...), one per line: "name index" or "name,index".
+std::vector<std::pair<std::string, int>> read_named_indices(const std::string& path);
+void write_named_indices(const std::string& path, const std::vector<std::pair<std::string, int>>& named);
 
 /// Throws InputError if any index is outside [0, n); `what` names the list in the message.
 void check_index_range(const std::vector<int>& indices, long n, const std::string& what);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 
 #include "breast_tumour_registration/core/newton_solver.h"
@@ -30,6 +31,21 @@ struct PhantomSceneSummary {
   NewtonResult prone, supine;
   std::vector<std::pair<std::string, double>> tumour_displacement;  ///< prone -> supine centroid [m]
 };
+
+/// The prone and supine configurations a generating material gives a rest model: gravity
+/// along +z (prone) and -z (supine) with the chest wall fixed, tumours carried along by
+/// their rest embedding.
+struct PhantomConfigurations {
+  Points prone, supine;
+  NewtonResult prone_newton, supine_newton;
+  std::map<std::string, SurfaceMesh> tumour_prone, tumour_supine;
+};
+
+/// Simulates the configurations of `model` with the generating material of `opt` (the
+/// phantom geometry options are not used). Throws InputError for bad parameters or a
+/// tumour outside the mesh, SolverError when a solve does not converge.
+PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomSceneOptions& opt,
+                                       const std::function<bool(const std::string&, const IterationInfo&)>& progress = {});
 
 /// Generates and writes the scene into `dir` (created). `progress` (optional) sees every
 /// Newton iteration of the "prone" and "supine" solves. Throws InputError / SolverError.

@@ -60,6 +60,14 @@ struct Scene {
   Rigid misalignment = Rigid::Identity();  ///< already applied to all supine data
 };
 
+/// The misalignment of thesis Sec. 5.2.5: rotations about X, then Y, then Z (degrees,
+/// about the model origin), then a translation (millimetres).
+Rigid misalignment_from_degrees_mm(const Vec3& rotation_deg, const Vec3& translation_mm);
+
+/// Moves all supine data of the scene (surface, cloud, rigid region, landmarks, ground
+/// truth) by `m`, as if the supine scan had been taken misaligned; composes s.misalignment.
+void apply_misalignment(Scene& s, const Rigid& m);
+
 /// Loads and validates a scene. Throws InputError naming the file and field at fault.
 Scene load_scene(const std::string& path);
 

@@ -1,0 +1,76 @@
+// The synthetic experiments of thesis Sec. 5.2 (Table 5.1), run on the built-in phantom or
+// on a user's rest model: every generating Young's modulus gives a prone and a supine
+// configuration; every experiment varies one input of the registration; every run gives
+// one row per tumour (centroid distance, Hausdorff, volume ratio, seconds).
+#pragma once
+
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/core/phantom.h"
+#include "breast_tumour_registration/core/phantom_scene.h"
+#include "breast_tumour_registration/core/scene.h"
+
+namespace btr {
+
+/// One configuration of one experiment: what it changes in the scene and the options.
+struct ExperimentRun {
+  std::string experiment;  ///< practical, rest_shape, rotated_gravity, misalignment, material, landmark_weight, landmark_set
+  std::string setting;     ///< e.g. the method ("full", "surface") or "with_rigid" / "without_rigid"
+  std::string variable;    ///< name of the swept variable (with its unit)
+  std::string value;       ///< its value, as written in the CSV
+  std::vector<std::string> steps;  ///< pipeline steps (empty: auto)
+  bool rest_as_rest_shape = false; ///< start from the true rest shape instead of the prone shape
+  Vec3 gravity_rotation_deg = Vec3::Zero();  ///< rotation of the method's gravity direction
+  Vec3 misalignment_rotation_deg = Vec3::Zero();
+  Vec3 misalignment_translation_mm = Vec3::Zero();
+  double method_youngs_modulus = 3400;  ///< the registration's material [Pa]
+  double landmark_weight = 1e4;         ///< [N/m]
+  std::string landmark_set = "C+O";     ///< a phantom_landmark_set name, or "all" (every landmark of the model)
+};
+
+struct ExperimentSuiteOptions {
+  std::vector<std::string> experiments;  ///< empty: all
+  std::vector<double> generating_youngs_moduli;  ///< empty: the thesis's 16 values
+  bool quick = false;                    ///< a few values per experiment (for tests)
+  double poisson_ratio = 0.49, density = 1000;
+  std::string preset = "balanced";
+};
+
+/// The thesis's generating Young's moduli: 200, 400, ..., 1000, 2000, ..., 12000 Pa.
+const std::vector<double>& thesis_youngs_moduli();
+/// Names of the experiments, in the thesis's order.
+const std::vector<std::string>& experiment_names();
+
+/// The runs of the chosen experiments (full sweeps of Table 5.1, or a few values each in
+/// quick mode). Throws InputError for an unknown experiment name.
+std::vector<ExperimentRun> plan_experiments(const ExperimentSuiteOptions& opt);
+
+/// The scene of one run: `model` deformed by `conf` (prone or rest shape as the start),
+/// the supine surface, landmarks and tumours of `conf`, with the run's misalignment,
+/// material, gravity, landmark set and steps applied.
+Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& conf, const ExperimentRun& run,
+                       const std::string& preset);
+
+struct ExperimentRow {
+  const ExperimentRun* run = nullptr;
+  double generating_youngs_modulus = 0;
+  std::string tumour;
+  double centroid_distance_mm = 0, hausdorff_mm = 0, volume_ratio = 0, seconds = 0;
+  std::string status;  ///< converged, not_converged, or failed: message
+};
+
+/// CSV header and row writers (one row per run and tumour).
+void write_experiment_csv_header(std::ostream& out);
+void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row);
+
+/// Runs `runs` on every generating modulus of `opt` and passes every row to `sink`.
+/// `progress` (optional) sees a line per generated configuration and per run. A run whose
+/// solver fails gives rows with status "failed: ..." and NaN figures; bad input throws.
+void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,
+                     const std::function<void(const ExperimentRow&)>& sink,
+                     const std::function<void(const std::string&)>& progress = {});
+
+}  // namespace btr

@@ -1,0 +1,168 @@
+// The experiment suite (thesis Sec. 5.2, Table 5.1): its plan, a quick run on the coarse
+// phantom whose figures must tell the thesis's story, and the same suite on a rest model
+// read from files.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/experiment_suite.h"
+#include "breast_tumour_registration/core/index_io.h"
+#include "breast_tumour_registration/core/rest_model_io.h"
+#include "breast_tumour_registration/core/surface_attachment.h"
+#include "test_util.h"
+
+namespace btr {
+namespace {
+
+const PhantomModel& coarse_phantom() {
+  static const PhantomModel m = [] {
+    PhantomOptions o;
+    o.tet.cell_size = 0.011;
+    return make_phantom_model(o);
+  }();
+  return m;
+}
+
+// Worst and best centroid distance [mm] per (experiment, setting, variable, value).
+struct Summary {
+  std::map<std::string, std::pair<double, double>> range;  // key -> (min, max)
+  int rows = 0, nonfinite = 0;
+  void add(const ExperimentRow& r) {
+    ++rows;
+    if (!std::isfinite(r.centroid_distance_mm) || !std::isfinite(r.hausdorff_mm) || !std::isfinite(r.volume_ratio)) ++nonfinite;
+    const std::string k = r.run->experiment + "/" + r.run->setting + "/" + r.run->variable + "=" + r.run->value;
+    auto it = range.find(k);
+    if (it == range.end()) range[k] = {r.centroid_distance_mm, r.centroid_distance_mm};
+    else it->second = {std::min(it->second.first, r.centroid_distance_mm), std::max(it->second.second, r.centroid_distance_mm)};
+  }
+  double max(const std::string& k) const { return range.at(k).second; }
+  double min(const std::string& k) const { return range.at(k).first; }
+};
+
+TEST(ExperimentPlan, CoversEveryValueOfTable51) {
+  const auto runs = plan_experiments({});
+  std::map<std::string, int> per;
+  for (const auto& r : runs) ++per[r.experiment];
+  EXPECT_EQ(per["practical"], 5);
+  EXPECT_EQ(per["rest_shape"], 2);
+  EXPECT_EQ(per["rotated_gravity"], 7);                   // 0, 2, ..., 10, 15 deg
+  EXPECT_EQ(per["misalignment"], 2 * (7 + 7 + 11 + 11));  // rot X, rot Z, shift X, shift Z; with and without rigid
+  EXPECT_EQ(per["material"], 16);
+  EXPECT_EQ(per["landmark_weight"], 4);
+  EXPECT_EQ(per["landmark_set"], 5);
+  EXPECT_EQ(thesis_youngs_moduli().size(), 16u);
+  ExperimentSuiteOptions o;
+  o.experiments = {"material", "landmark_set"};
+  EXPECT_EQ(plan_experiments(o).size(), 21u);
+  o.experiments = {"materials"};
+  test::expect_throw_with<InputError>([&] { plan_experiments(o); }, "unknown experiment 'materials'");
+}
+
+TEST(ExperimentSuite, QuickRunReproducesTheThesisFindings) {
+  ExperimentSuiteOptions o;
+  o.quick = true;
+  o.generating_youngs_moduli = {4000};
+  const auto runs = plan_experiments(o);
+  Summary s;
+  std::ostringstream csv;
+  write_experiment_csv_header(csv);
+  run_experiments(coarse_phantom(), o, runs, [&](const ExperimentRow& r) {
+    s.add(r);
+    write_experiment_csv_row(csv, r);
+    EXPECT_NE(r.status.rfind("failed", 0), 0u) << r.status;
+  });
+  EXPECT_EQ(s.rows, static_cast<int>(runs.size()) * 5);
+  EXPECT_EQ(s.nonfinite, 0);
+  // One header and one line per row, eleven fields each.
+  std::istringstream lines(csv.str());
+  std::string line;
+  int n = 0;
+  while (std::getline(lines, line)) {
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 10) << line;
+    ++n;
+  }
+  EXPECT_EQ(n, s.rows + 1);
+  // Practical settings (Fig. 5.4): the full method beats each part of it, and rigid alone is worst.
+  const double full = s.max("practical/full/method=full");
+  EXPECT_LT(full, 0.5);
+  EXPECT_LT(full, s.min("practical/landmarks/method=landmarks"));
+  EXPECT_LT(s.max("practical/landmarks/method=landmarks"), s.min("practical/rigid/method=rigid"));
+  EXPECT_LT(s.max("practical/surface/method=surface"), s.min("practical/rigid/method=rigid"));
+  // Rest shape (Fig. 5.5): knowing the true rest shape does not hurt.
+  EXPECT_LE(s.max("rest_shape/full/rest_shape=rest"), s.max("rest_shape/full/rest_shape=prone") + 0.05);
+  // Misalignment (Fig. 5.9): without the rigid step a 15 deg tilt breaks the method; with it, not.
+  EXPECT_GT(s.max("misalignment/without_rigid/rotation_x_deg=15"), 3.0);
+  EXPECT_LT(s.max("misalignment/with_rigid/rotation_x_deg=15"), 0.5);
+  EXPECT_GT(s.max("misalignment/without_rigid/translation_z_mm=10"), 3.0);
+  EXPECT_LT(s.max("misalignment/with_rigid/translation_z_mm=10"), 0.5);
+}
+
+TEST(ExperimentSuite, RunsOnARestModelReadFromFiles) {
+  const std::string dir = test::temp_dir();
+  write_rest_model(dir, coarse_phantom(), LengthUnit::Millimetre);
+  const PhantomModel m = load_rest_model(dir + "/model.yaml");
+  EXPECT_EQ(m.rest.T.rows(), coarse_phantom().rest.T.rows());
+  EXPECT_EQ(m.landmarks, coarse_phantom().landmarks);
+  EXPECT_EQ(m.tumours.size(), 5u);
+  EXPECT_NEAR((m.rest.V - coarse_phantom().rest.V).cwiseAbs().maxCoeff(), 0, 1e-8);
+
+  ExperimentSuiteOptions o;
+  o.experiments = {"practical"};
+  o.generating_youngs_moduli = {4000};
+  Summary s;
+  run_experiments(m, o, plan_experiments(o), [&](const ExperimentRow& r) { s.add(r); });
+  EXPECT_EQ(s.rows, 25);
+  EXPECT_LT(s.max("practical/full/method=full"), 0.5);
+  EXPECT_GT(s.min("practical/rigid/method=rigid"), 1.0);
+
+  // A model with only its own landmark names runs the default set ("all") and skips the thesis's sets.
+  write_named_indices(dir + "/few.txt", {{"apex", m.landmarks.at("C")}, {"a", m.landmarks.at("O1")},
+                                         {"b", m.landmarks.at("O2")}, {"c", m.landmarks.at("O3")}});
+  test::write_text(dir + "/few.yaml", "rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: few.txt\n"
+                                      "tumours: {top: tumour_top_rest.obj}\n");
+  const PhantomModel few = load_rest_model(dir + "/few.yaml");
+  o.experiments = {"landmark_set", "landmark_weight"};
+  o.quick = true;
+  std::vector<std::string> said;
+  Summary f;
+  run_experiments(few, o, plan_experiments(o), [&](const ExperimentRow& r) { f.add(r); },
+                  [&](const std::string& line) { said.push_back(line); });
+  EXPECT_EQ(f.rows, 2);  // two landmark weights x one tumour; both landmark sets skipped
+  EXPECT_TRUE(std::any_of(said.begin(), said.end(), [](const std::string& l) { return l.find("skipped landmark_set") == 0; }));
+}
+
+TEST(RestModelErrors, NameTheFieldAtFault) {
+  const std::string dir = test::temp_dir();
+  write_rest_model(dir, coarse_phantom(), LengthUnit::Millimetre);
+  auto with = [&](const std::string& yaml) {
+    test::write_text(dir + "/bad.yaml", yaml);
+    return dir + "/bad.yaml";
+  };
+  test::expect_throw_with<InputError>([&] { load_rest_model(dir + "/none.yaml"); }, "cannot open rest model");
+  test::expect_throw_with<InputError>([&] { load_rest_model(with("rest: rest.vtk\n")); }, "field 'chest_wall': missing");
+  std::vector<int> on_surface;
+  boundary_surface(coarse_phantom().rest, &on_surface);
+  std::sort(on_surface.begin(), on_surface.end());
+  int inner = 0;
+  while (std::binary_search(on_surface.begin(), on_surface.end(), inner)) ++inner;
+  test::write_text(dir + "/inner.txt", "deep " + std::to_string(inner) + "\n");
+  test::expect_throw_with<InputError>(
+      [&] { load_rest_model(with("rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: inner.txt\ntumours: {t: tumour_top_rest.obj}\n")); },
+      "is not on the surface");
+  test::write_text(dir + "/range.txt", "far 999999\n");
+  test::expect_throw_with<InputError>(
+      [&] { load_rest_model(with("rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: range.txt\ntumours: {t: tumour_top_rest.obj}\n")); },
+      "field 'landmarks'");
+  test::expect_throw_with<InputError>(
+      [&] { load_rest_model(with("rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: landmark_vertices.txt\ntumours: {t: missing.obj}\n")); },
+      "field 'tumours.t'");
+  test::write_text(dir + "/dup.txt", "a 1\na 2\n");
+  test::expect_throw_with<InputError>([&] { read_named_indices(dir + "/dup.txt"); }, "given twice");
+}
+
+}  // namespace
+}  // namespace btr
