@@ -67,8 +67,9 @@ void write_experiment_csv_header(std::ostream& out);
 void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row);
 
 /// Runs `runs` on every generating modulus of `opt` and passes every row to `sink`.
-/// `progress` (optional) sees a line per generated configuration and per run. A run whose
-/// solver fails gives rows with status "failed: ..." and NaN figures; bad input throws.
+/// `progress` (optional) sees a line per generated configuration and per run. A run that
+/// fails (a solver failure, a generated prone mesh with a flat element) gives rows with
+/// status "failed: ..." and NaN figures; an unknown preset throws InputError.
 void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,
                      const std::function<void(const ExperimentRow&)>& sink,
                      const std::function<void(const std::string&)>& progress = {});
