@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/core/landmark_step.h"
 
+#include <chrono>
+
 #include <memory>
 
 #include "breast_tumour_registration/core/elastic_energy.h"
@@ -12,6 +14,7 @@ namespace btr {
 
 StepReport landmark_step(const RegistrationModel& model, const std::vector<Anchor>& anchors, const Points& targets,
                          const LandmarkStepOptions& opt, Points& x, const StepCallback& callback) {
+  const auto t0 = std::chrono::steady_clock::now();
   if (anchors.empty()) throw InputError("landmark step: no landmarks");
   if (static_cast<Eigen::Index>(anchors.size()) != targets.rows())
     throw InputError("landmark step: " + std::to_string(anchors.size()) + " prone landmarks but " +
@@ -45,6 +48,8 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
   rep.stop_reason = to_string(r.reason);
   rep.iterations = r.iterations;
   rep.seconds = r.seconds;
+  rep.add_newton_profile(r);
+  rep.t_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() - r.seconds;
   rep.energy = r.energy;
   rep.gradient_norm = r.gradient_norm;
   return rep;

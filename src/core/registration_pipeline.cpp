@@ -8,6 +8,7 @@
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/elastic_energy.h"
 #include "breast_tumour_registration/core/metrics.h"
+#include "breast_tumour_registration/core/simulation_mesh.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 
 namespace btr {
@@ -87,6 +88,19 @@ PlannedSteps plan_steps(const Scene& s) {
   if (!p.rigid_landmarks && !p.rigid_icp && !p.gravity && !p.landmarks && !p.surface)
     throw InputError(s.path + ": nothing to do: the scene has no landmarks, no supine surface and no rigid regions");
   return p;
+}
+
+std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt) {
+  if (opt.simulation_cell_size <= 0) return std::nullopt;
+  double sum = 0;
+  long n = 0;
+  for (Eigen::Index t = 0; t < scene.prone.T.rows(); ++t)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b, ++n)
+        sum += (scene.prone.V.row(scene.prone.T(t, a)) - scene.prone.V.row(scene.prone.T(t, b))).norm();
+  const double mean_edge = n ? sum / static_cast<double>(n) : 0;
+  if (mean_edge >= 0.75 * opt.simulation_cell_size) return std::nullopt;
+  return with_simulation_mesh(scene, opt.simulation_cell_size);
 }
 
 RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings) {
@@ -186,6 +200,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     rep.seconds = since(tg);
     rep.energy = nr.energy;
     rep.gradient_norm = nr.gradient_norm;
+    rep.add_newton_profile(nr);
     r.reports.push_back(rep);
   }
   // 3. Landmark-guided step.

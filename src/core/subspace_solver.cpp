@@ -100,7 +100,7 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
     H.scatter_add(U * d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
-    info.t_solve = since(t0);
+    info.t_solve += since(t0);
     if (apply_newton_step(energy, tets, opt, dx, gr.dot(d), x, x_trial, E, n_inv, info, res) != StepOutcome::Taken) break;
     gr = Ut * H.gather(energy.gradient(x));
     info.gradient_norm = gr.norm();

@@ -34,9 +34,11 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
 
   StepReport rep;
   rep.name = "surface";
+  rep.t_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Points targets = Points::Zero(static_cast<Eigen::Index>(model.skin.size()), 3);
   int offset = 0;
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
+    const auto tp = std::chrono::steady_clock::now();
     points->clear();
     planes->clear();
     double moved = 0, moved_sq = 0;
@@ -54,6 +56,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       ++kept;
     }
     const double moved_rms = std::sqrt(moved_sq / static_cast<double>(model.skin.size()));
+    rep.t_projection += std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
     rep.projection_rms_change = moved_rms;
     rep.projection_max_change = moved;
     if (kept == 0)
@@ -67,6 +70,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     };
     const NewtonResult r = solver.solve(energy, x, nopt);
     offset += r.iterations;
+    rep.add_newton_profile(r);
     rep.iterations += r.iterations;
     rep.outer_iterations = outer;
     rep.energy = r.energy;

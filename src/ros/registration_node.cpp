@@ -91,6 +91,7 @@ void RegistrationNode::load_scene() {
     std::vector<std::string> warnings;
     model_ = prepare_model(*scene_, warnings);
     for (const auto& w : warnings) ROS_WARN_STREAM("scene: " << w);
+    simulation_for(preset_options(params_.preset));  // the default preset's simulation mesh, ready before any call
     if (!scene_->prone_rigid) {
       ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
     } else {
@@ -107,6 +108,7 @@ void RegistrationNode::load_scene() {
   } catch (const std::exception& e) {
     scene_.reset();
     model_.reset();
+    simulations_.clear();
     scene_error_ = e.what();
     ROS_ERROR_STREAM("cannot load the scene: " << scene_error_ << " (the node keeps running; fix ~scene and restart)");
     publish_status(diagnostic_msgs::DiagnosticStatus::ERROR, "scene failed to load: " + scene_error_);
@@ -182,6 +184,29 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   }
 }
 
+std::shared_ptr<const RegistrationNode::Simulation> RegistrationNode::simulation_for(const RegistrationOptions& opt) {
+  auto it = simulations_.find(opt.simulation_cell_size);
+  if (it != simulations_.end()) return it->second;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::optional<Scene> coarse = simulation_scene(*scene_, opt);
+  std::shared_ptr<const Simulation> sim;
+  if (!coarse) {
+    sim = std::make_shared<Simulation>(Simulation{*scene_, *model_});
+  } else {
+    std::vector<std::string> warnings;
+    RegistrationModel m = prepare_model(*coarse, warnings);
+    for (const auto& w : warnings) ROS_WARN_STREAM("simulation mesh: " << w);
+    const Scene& s = *coarse;
+    ROS_INFO("simulation mesh for cell size %.1f mm: %ld tetrahedra (scene: %ld), prepared in %.2f s",
+             opt.simulation_cell_size * 1e3, static_cast<long>(s.prone.T.rows()),
+             static_cast<long>(scene_->prone.T.rows()),
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    sim = std::make_shared<Simulation>(Simulation{std::move(*coarse), std::move(m)});
+  }
+  simulations_[opt.simulation_cell_size] = sim;
+  return sim;
+}
+
 bool RegistrationNode::on_register(breast_tumour_registration::Register::Request& req,
                                    breast_tumour_registration::Register::Response& res) {
   std::unique_lock<std::mutex> busy(registration_mutex_, std::try_to_lock);
@@ -194,7 +219,8 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     if (!model_) throw InputError("the scene failed to load: " + scene_error_ + "; fix ~scene and restart the node");
     const std::string preset = req.preset.empty() ? params_.preset : req.preset;
     RegistrationOptions opt = preset_options(preset);
-    Scene scene = *scene_;
+    const std::shared_ptr<const Simulation> sim = simulation_for(opt);
+    Scene scene = sim->scene;
     scene.preset = preset;
     if (req.use_latest_cloud) {
       Points cloud;
@@ -250,8 +276,8 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       explicit Flag(std::atomic<bool>& x) : f(x) { f = true; }
       ~Flag() { f = false; }
     } running(registering_);
-    const RegistrationResult r = run_registration(scene, *model_, opt);
-    publish_result(r, *model_, preset, res.result);
+    const RegistrationResult r = run_registration(scene, sim->model, opt);
+    publish_result(r, sim->model, preset, res.result);
     res.success = true;
     res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")" +
                   (r.converged ? "" : "; a step stopped without converging, try the accurate preset");

@@ -20,13 +20,16 @@ int main(int argc, char** argv) {
       "subspace step, surface-guided step) and write the registered tumour(s), meshes, report.json and a PNG.\n"
       "Exit codes: 0 converged, 2 invalid input, 3 numerical failure, 4 finished without converging (outputs written)."};
   std::string scene_path, out_dir = "registration", preset, steps;
-  double tumour_E = 0;
+  double tumour_E = 0, cell_mm = -1;
   bool quiet = false;
   app.add_option("scene", scene_path, "scene file (YAML), e.g. written by btr_phantom")->required();
   app.add_option("-o,--out", out_dir, "output folder (created)")->capture_default_str();
   app.add_option("-p,--preset", preset, "fast, balanced or accurate (default: the scene's, else balanced)");
   app.add_option("-s,--steps", steps, "override the scene's steps: auto, or a comma list of rigid,gravity,landmarks,surface");
   app.add_option("--tumour-youngs-modulus", tumour_E, "give tumour elements this Young's modulus [Pa] (stiffer tumour)");
+  app.add_option("--cell-size", cell_mm,
+                 "simulate on the prone model re-tetrahedralized at this cell size [mm] (default: the preset's; 0: the "
+                 "scene's mesh as given)");
   app.add_flag("-q,--quiet", quiet, "no progress display");
   CLI11_PARSE(app, argc, argv);
 
@@ -46,7 +49,13 @@ int main(int argc, char** argv) {
       }
     }
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
-    const RegistrationOptions opt = preset_options(scene.preset);
+    RegistrationOptions opt = preset_options(scene.preset);
+    if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
+    if (auto coarse = simulation_scene(scene, opt)) {
+      scene = std::move(*coarse);
+      std::printf("[register] simulating on the prone model re-tetrahedralized at %.1f mm (%.2f s; --cell-size 0 keeps "
+                  "the scene's mesh)\n", opt.simulation_cell_size * 1e3, scene.tetrahedralize_seconds);
+    }
     const PlannedSteps plan = plan_steps(scene);
     std::vector<std::string> warnings;
     const RegistrationModel model = prepare_model(scene, warnings);
@@ -71,9 +80,14 @@ int main(int argc, char** argv) {
       std::printf("[rigid   ] %.2f deg, %.2f mm (%s) in %.3f s\n", rotation_angle(r.supine_to_model) * 180 / M_PI,
                   r.supine_to_model.translation().norm() * 1e3, r.icp_used ? "landmarks + ICP" : r.icp.message.empty() ? "landmarks" : r.icp.message.c_str(),
                   r.rigid_seconds);
-    for (const auto& s : r.reports)
+    for (const auto& s : r.reports) {
       std::printf("[%-8s] %s: %d Newton iterations%s in %.3f s\n", s.name.c_str(), s.stop_reason.c_str(), s.iterations,
                   s.outer_iterations ? (", " + std::to_string(s.outer_iterations) + " projections").c_str() : "", s.seconds);
+      std::printf("[%-8s]   setup %.3f, assembly %.3f, factorization %.3f (%d), solve %.3f (%d PCG iterations), "
+                  "line search %.3f, projection %.3f s\n",
+                  s.name.c_str(), s.t_setup, s.t_assembly, s.t_factorization, s.factorizations, s.t_solve, s.pcg_iterations,
+                  s.t_line_search, s.t_projection);
+    }
     for (const auto& w : r.warnings)
       if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) std::printf("[register] warning: %s\n", w.c_str());
     for (const auto& t : r.tumours) {

@@ -12,6 +12,7 @@
 #include "breast_tumour_registration/core/phantom_scene.h"
 #include "breast_tumour_registration/core/registration_report.h"
 #include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/core/simulation_mesh.h"
 #include "breast_tumour_registration/core/skinning_subspace.h"
 #include "test_util.h"
 
@@ -366,4 +367,32 @@ TEST(Registration, SupinePointCloudInsteadOfASurface) {
   EXPECT_LT(worst_error(r), 0.5e-3);
   expect_throw_with<InputError>([&] { read_point_cloud(phantom_dir() + "/nothing.pcd", LengthUnit::Millimetre); },
                                 "unknown point cloud format");
+}
+
+TEST(SimulationMesh, ACoarserMeshKeepsChestWallLandmarksAndAccuracy) {
+  const Scene scene = load_scene(phantom_dir() + "/scene.yaml");
+  RegistrationOptions opt = preset_options("balanced");
+  opt.simulation_cell_size = 0.006;  // finer than the scene's 12 mm: keep the scene's mesh
+  EXPECT_FALSE(simulation_scene(scene, opt).has_value());
+  opt.simulation_cell_size = 0.025;
+  const std::optional<Scene> coarse = simulation_scene(scene, opt);
+  ASSERT_TRUE(coarse.has_value());
+  EXPECT_LT(coarse->prone.T.rows(), scene.prone.T.rows() / 2);
+  EXPECT_EQ(coarse->landmark_anchors.size(), scene.landmark_anchors.size());
+  // The chest wall is found again: every fixed vertex lies on the plane z = 0 of the prone model.
+  ASSERT_GT(coarse->chest_wall.size(), 10u);
+  for (int v : coarse->chest_wall) EXPECT_NEAR(coarse->prone.V(v, 2), 0.0, 1e-6);
+  // The landmarks stay on the prone skin, within the coarse surface's approximation error
+  // (facet distance 0.1 x cell size).
+  for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
+    EXPECT_LT((coarse->landmark_anchors[i].position(coarse->prone.V) - scene.landmark_anchors[i].position(scene.prone.V)).norm(),
+              0.15 * opt.simulation_cell_size);
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(*coarse, warnings);
+  const RegistrationResult r = run_registration(*coarse, m, opt);
+  for (const auto& t : r.tumours) {
+    EXPECT_LT(t.centroid_distance, 1.0e-3) << t.name;
+    EXPECT_LT(t.centroid_distance, 0.5 * t.rigid_centroid_distance) << t.name;
+  }
+  expect_throw_with<InputError>([&] { with_simulation_mesh(scene, -1); }, "must be positive");
 }

@@ -66,6 +66,20 @@ struct StepReport {
   double gradient_norm = 0;
   double projection_rms_change = 0;  ///< surface step: last RMS change of the projections [m]
   double projection_max_change = 0;  ///< surface step: last max change [m]
+  /// Where the time went [s]: setup (energies, subspace, symbolic analysis), Hessian
+  /// assembly, numeric factorizations, linear solves (PCG included), line search and the
+  /// surface projections; with the number of factorizations and PCG iterations.
+  double t_setup = 0, t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0, t_projection = 0;
+  int factorizations = 0, pcg_iterations = 0;
+  /// Adds a Newton solve's time split and counts.
+  void add_newton_profile(const NewtonResult& r) {
+    t_assembly += r.t_assembly;
+    t_factorization += r.t_factorization;
+    t_solve += r.t_solve;
+    t_line_search += r.t_line_search;
+    factorizations += r.factorizations;
+    pcg_iterations += r.pcg_iterations;
+  }
 };
 
 }  // namespace btr

@@ -20,6 +20,9 @@ struct RegistrationOptions {
   LandmarkStepOptions landmark;
   SurfaceStepOptions surface;
   NewtonOptions gravity;  ///< gravity pre-step
+  /// > 0: simulate on the prone model re-tetrahedralized at this cell size [m] when the
+  /// scene's mesh is finer (see simulation_scene); 0: the scene's mesh as given.
+  double simulation_cell_size = 0;
   /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
   /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
   std::optional<Rigid> known_supine_to_model;
@@ -43,6 +46,12 @@ struct PlannedSteps {
 /// explicit list is checked against the inputs; a missing input is an InputError naming
 /// the field.
 PlannedSteps plan_steps(const Scene& scene);
+
+/// When opt.simulation_cell_size asks for a coarser mesh than the scene's (mean edge below
+/// 3/4 of the cell size): the scene with its prone model re-tetrahedralized
+/// (with_simulation_mesh); otherwise nullopt (simulate on the scene's mesh). Callers
+/// prepare it once and cache it with its model.
+std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt);
 
 /// Builds the registration model of a scene (material, tumours embedded, stiffer tumour if
 /// asked). `warnings` receives messages about tumour points outside the mesh.

@@ -14,6 +14,8 @@
 
 #include <atomic>
 #include <memory>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -60,9 +62,16 @@ class RegistrationNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParameters params_;
-  // Cached model (built once at start-up).
+  // Cached model (built once at start-up) and, per simulation cell size a preset asks for,
+  // the scene and model it simulates on (built on first use, under registration_mutex_).
   std::optional<Scene> scene_;
   std::optional<RegistrationModel> model_;
+  struct Simulation {
+    Scene scene;
+    RegistrationModel model;
+  };
+  std::map<double, std::shared_ptr<const Simulation>> simulations_;
+  std::shared_ptr<const Simulation> simulation_for(const RegistrationOptions& opt);
   std::string scene_error_;
   // Latest cloud (working frame, organized with NaN) and the tracked rigid alignment.
   std::mutex state_mutex_;

@@ -1,0 +1,120 @@
+// btr_bench_tradeoff: the speed/accuracy trade of the registration on a phantom scene whose
+// ground truth was generated on its own (fine) mesh. It sweeps what a user can turn: the
+// simulation mesh (the prone model re-tetrahedralized at a cell size), the subspace size,
+// the landmark step's tolerance, the surface step's projection budget, and the presets; for
+// each point it writes one CSV row: median registration seconds over the repeats (the cost
+// of a service call once the model is prepared), the one-off preparation seconds, and the
+// worst and mean tumour centroid error. Plot with bench/plot_tradeoff.py.
+//   btr_bench_tradeoff SCENE.yaml --repeats 3 --out tradeoff.csv
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <vector>
+
+#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/registration_pipeline.h"
+#include "breast_tumour_registration/core/simulation_mesh.h"
+
+using namespace btr;
+
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+struct Point {
+  std::string knob, value, base;  // what was turned, to what, from which preset
+  double cell_mm = 0;             // 0: the scene's own mesh
+  RegistrationOptions opt;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Sweep the registration's speed/accuracy knobs on a phantom scene; one CSV row per setting."};
+  std::string scene_path, out_path = "tradeoff.csv";
+  int repeats = 3;
+  std::vector<double> cells = {14, 11, 9, 7, 5.5, 4.5};
+  app.add_option("scene", scene_path, "scene with ground-truth tumours (btr_phantom)")->required();
+  app.add_option("--repeats", repeats, "timed registrations per setting (median)")->capture_default_str();
+  app.add_option("--cell-sizes", cells, "simulation mesh cell sizes to sweep [mm]");
+  app.add_option("-o,--out", out_path, "CSV file")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const Scene scene = load_scene(scene_path);
+    std::vector<Point> points;
+    for (const std::string preset : {"fast", "balanced", "accurate"}) {
+      for (double c : cells) points.push_back({"cell_size_mm", std::to_string(c), preset, c, preset_options(preset)});
+      points.push_back({"preset", preset, preset, 0, preset_options(preset)});
+    }
+    for (double c : {0.0, 7.0}) {  // solver knobs on the scene's mesh and on a coarse one
+      for (int h : {10, 20, 40, 60, 100, 160}) {
+        Point p{"subspace_handles", std::to_string(h), "balanced", c, preset_options("balanced")};
+        p.opt.landmark.subspace.handles = h;
+        points.push_back(p);
+      }
+      for (double tol : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6}) {
+        Point p{"landmark_tolerance", std::to_string(tol), "balanced", c, preset_options("balanced")};
+        p.opt.landmark.newton.gradient_rel_tolerance = tol;
+        p.opt.landmark.newton.max_iterations = 50;
+        points.push_back(p);
+      }
+      for (int k : {1, 2, 3, 4, 6, 10, 20, 40}) {
+        Point p{"max_projections", std::to_string(k), "balanced", c, preset_options("balanced")};
+        p.opt.surface.max_projections = k;
+        points.push_back(p);
+      }
+    }
+    std::ofstream csv(out_path);
+    if (!csv) throw InputError("cannot write '" + out_path + "'");
+    csv << "knob,value,base_preset,cell_size_mm,tetrahedra,prepare_seconds,seconds_median,worst_error_mm,mean_error_mm,"
+           "converged\n";
+    // One prepared model per simulation mesh (as a node caches it).
+    std::map<double, std::pair<Scene, RegistrationModel>> models;
+    std::map<double, double> prepare_seconds;
+    for (const Point& p : points) {
+      if (!models.count(p.cell_mm)) {
+        const auto t0 = std::chrono::steady_clock::now();
+        Scene s = p.cell_mm > 0 ? with_simulation_mesh(scene, p.cell_mm * 1e-3) : scene;
+        std::vector<std::string> warnings;
+        RegistrationModel m = prepare_model(s, warnings);
+        prepare_seconds[p.cell_mm] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        models.emplace(p.cell_mm, std::make_pair(std::move(s), std::move(m)));
+      }
+      const auto& [s, m] = models.at(p.cell_mm);
+      std::vector<double> secs;
+      RegistrationResult r;
+      for (int i = 0; i < repeats; ++i) {
+        r = run_registration(s, m, p.opt);
+        secs.push_back(r.seconds);
+      }
+      double worst = 0, mean = 0;
+      for (const auto& t : r.tumours) {
+        worst = std::max(worst, t.centroid_distance * 1e3);
+        mean += t.centroid_distance * 1e3 / static_cast<double>(r.tumours.size());
+      }
+      csv << p.knob << ',' << p.value << ',' << p.base << ',' << p.cell_mm << ',' << m.rest.T.rows() << ','
+          << prepare_seconds[p.cell_mm] << ',' << median(secs) << ',' << worst << ',' << mean << ','
+          << (r.converged ? 1 : 0) << '\n';
+      csv.flush();
+      std::printf("%-18s %-10s %-8s cell %4.1f mm %6ld tets: %.3f s, worst %.3f mm, mean %.3f mm%s\n", p.knob.c_str(),
+                  p.value.c_str(), p.base.c_str(), p.cell_mm, static_cast<long>(m.rest.T.rows()), median(secs), worst, mean,
+                  r.converged ? "" : " (not converged)");
+      std::fflush(stdout);
+    }
+    return 0;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "btr_bench_tradeoff: invalid input: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "btr_bench_tradeoff: error: %s\n", e.what());
+    return 1;
+  }
+}
