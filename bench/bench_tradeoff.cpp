@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <vector>
 
 #include "breast_tumour_registration/core/errors.h"
@@ -22,6 +23,12 @@
 using namespace btr;
 
 namespace {
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -51,7 +58,7 @@ int main(int argc, char** argv) {
     const Scene scene = load_scene(scene_path);
     std::vector<Point> points;
     for (const std::string preset : {"fast", "balanced", "accurate"}) {
-      for (double c : cells) points.push_back({"cell_size_mm", std::to_string(c), preset, c, preset_options(preset)});
+      for (double c : cells) points.push_back({"cell_size_mm", fmt(c), preset, c, preset_options(preset)});
       points.push_back({"preset", preset, preset, 0, preset_options(preset)});
     }
     for (double c : {0.0, 7.0}) {  // solver knobs on the scene's mesh and on a coarse one
@@ -61,7 +68,7 @@ int main(int argc, char** argv) {
         points.push_back(p);
       }
       for (double tol : {1e-2, 1e-3, 1e-4, 1e-5, 1e-6}) {
-        Point p{"landmark_tolerance", std::to_string(tol), "balanced", c, preset_options("balanced")};
+        Point p{"landmark_tolerance", fmt(tol), "balanced", c, preset_options("balanced")};
         p.opt.landmark.newton.gradient_rel_tolerance = tol;
         p.opt.landmark.newton.max_iterations = 50;
         points.push_back(p);
