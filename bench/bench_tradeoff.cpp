@@ -53,13 +53,17 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "timed registrations per setting (median)")->capture_default_str();
   app.add_option("--cell-sizes", cells, "simulation mesh cell sizes to sweep [mm]");
   app.add_option("-o,--out", out_path, "CSV file")->capture_default_str();
+  std::vector<std::string> knobs;
+  app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections");
   CLI11_PARSE(app, argc, argv);
   try {
     const Scene scene = load_scene(scene_path);
     std::vector<Point> points;
     for (const std::string preset : {"fast", "balanced", "accurate"}) {
       for (double c : cells) points.push_back({"cell_size_mm", fmt(c), preset, c, preset_options(preset)});
-      points.push_back({"preset", preset, preset, 0, preset_options(preset)});
+      // The preset as a user gets it: with its own simulation mesh (the scene's when 0).
+      const RegistrationOptions po = preset_options(preset);
+      points.push_back({"preset", preset, preset, po.simulation_cell_size * 1e3, po});
     }
     for (double c : {0.0, 7.0}) {  // solver knobs on the scene's mesh and on a coarse one
       for (int h : {10, 20, 40, 60, 100, 160}) {
@@ -79,6 +83,10 @@ int main(int argc, char** argv) {
         points.push_back(p);
       }
     }
+    if (!knobs.empty())
+      points.erase(std::remove_if(points.begin(), points.end(),
+                                  [&](const Point& p) { return std::find(knobs.begin(), knobs.end(), p.knob) == knobs.end(); }),
+                   points.end());
     std::ofstream csv(out_path);
     if (!csv) throw InputError("cannot write '" + out_path + "'");
     csv << "knob,value,base_preset,cell_size_mm,tetrahedra,prepare_seconds,seconds_median,worst_error_mm,mean_error_mm,"

@@ -372,7 +372,7 @@ TEST(Registration, SupinePointCloudInsteadOfASurface) {
 TEST(SimulationMesh, ACoarserMeshKeepsChestWallLandmarksAndAccuracy) {
   const Scene scene = load_scene(phantom_dir() + "/scene.yaml");
   RegistrationOptions opt = preset_options("balanced");
-  opt.simulation_cell_size = 0.006;  // finer than the scene's 12 mm: keep the scene's mesh
+  opt.simulation_cell_size = 0.012;  // the scene's own 12 mm: keep the scene's mesh
   EXPECT_FALSE(simulation_scene(scene, opt).has_value());
   opt.simulation_cell_size = 0.025;
   const std::optional<Scene> coarse = simulation_scene(scene, opt);

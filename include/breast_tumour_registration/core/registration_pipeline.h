@@ -47,8 +47,8 @@ struct PlannedSteps {
 /// the field.
 PlannedSteps plan_steps(const Scene& scene);
 
-/// When opt.simulation_cell_size asks for a coarser mesh than the scene's (mean edge below
-/// 3/4 of the cell size): the scene with its prone model re-tetrahedralized
+/// When opt.simulation_cell_size asks for a clearly coarser mesh than the scene's (mean edge
+/// below 1.1 cell sizes; a mesh made at that size has about 1.35): the scene with its prone model re-tetrahedralized
 /// (with_simulation_mesh); otherwise nullopt (simulate on the scene's mesh). Callers
 /// prepare it once and cache it with its model.
 std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt);
