@@ -39,7 +39,8 @@ def main():
     for r in rows:
         if r["knob"] == "preset":
             ax.scatter([r["s"]], [r["e"]], marker="*", s=180, edgecolor="k", zorder=5)
-            ax.annotate(r["value"] + " (scene mesh)", (r["s"], r["e"]), textcoords="offset points", xytext=(6, 6))
+            mesh = "scene mesh" if float(r["cell_size_mm"]) == 0 else f"{float(r['cell_size_mm']):g} mm mesh"
+            ax.annotate(f"{r['value']} ({mesh})", (r["s"], r["e"]), textcoords="offset points", xytext=(6, 6))
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("registration time per call [s] (median)")
