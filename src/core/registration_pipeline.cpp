@@ -39,7 +39,7 @@ RegistrationOptions preset_options(const std::string& name) {
     o.landmark.subspace.handles = 60;
     o.landmark.newton.max_iterations = 10;
     o.landmark.newton.gradient_rel_tolerance = 1e-4;
-    o.surface.max_projections = 6;
+    o.surface.max_projections = 4;
     o.surface.newton_per_projection = 1;
   } else if (name == "accurate") {  // the scene's own mesh
     o.landmark.subspace.handles = 60;
