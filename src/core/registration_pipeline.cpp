@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/core/metrics.h"
 #include "breast_tumour_registration/core/simulation_mesh.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/validation.h"
 
 namespace btr {
 namespace {
@@ -97,13 +98,7 @@ PlannedSteps plan_steps(const Scene& s) {
 
 std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt) {
   if (opt.simulation_cell_size <= 0) return std::nullopt;
-  double sum = 0;
-  long n = 0;
-  for (Eigen::Index t = 0; t < scene.prone.T.rows(); ++t)
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b, ++n)
-        sum += (scene.prone.V.row(scene.prone.T(t, a)) - scene.prone.V.row(scene.prone.T(t, b))).norm();
-  const double mean_edge = n ? sum / static_cast<double>(n) : 0;
+  const double mean_edge = mean_edge_length(scene.prone);
   // CGAL's meshes at cell size c have a mean edge of about 1.35 c (1.34 measured on the
   // phantom at 4.7 mm): remesh only a scene mesh clearly finer than that.
   if (mean_edge >= 1.1 * opt.simulation_cell_size) return std::nullopt;

@@ -80,24 +80,29 @@ bool orient_tets_positive(TetMesh& m) {
   return true;
 }
 
+double mean_edge_length(const TetMesh& m) {
+  double sum = 0;
+  for (Eigen::Index t = 0; t < m.T.rows(); ++t)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) sum += (m.V.row(m.T(t, a)) - m.V.row(m.T(t, b))).norm();
+  return m.T.rows() ? sum / (6.0 * static_cast<double>(m.T.rows())) : 0.0;
+}
+
 void validate_tet_mesh(const TetMesh& m, const std::string& name, double degenerate_rel) {
   if (m.T.rows() == 0) throw InputError(name + ": mesh has no tetrahedra");
   check_finite(m.V, name);
   const long nv = m.V.rows();
-  double edge_sum = 0;
   for (Eigen::Index t = 0; t < m.T.rows(); ++t) {
     for (int c = 0; c < 4; ++c)
       if (m.T(t, c) < 0 || m.T(t, c) >= nv)
         throw InputError(name + ": tetrahedron " + std::to_string(t) + " references vertex " +
                          std::to_string(m.T(t, c)) + " but there are " + std::to_string(nv) + " vertices");
     for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) {
+      for (int b = a + 1; b < 4; ++b)
         if (m.T(t, a) == m.T(t, b))
           throw InputError(name + ": tetrahedron " + std::to_string(t) + " repeats vertex " + std::to_string(m.T(t, a)));
-        edge_sum += (m.V.row(m.T(t, a)) - m.V.row(m.T(t, b))).norm();
-      }
   }
-  const double h = edge_sum / (6.0 * m.T.rows());
+  const double h = mean_edge_length(m);
   const double vmin = degenerate_rel * h * h * h;
   long inverted = 0, first_inverted = -1;
   for (Eigen::Index t = 0; t < m.T.rows(); ++t) {

@@ -21,6 +21,9 @@ void validate_surface(const SurfaceMesh& mesh, const std::string& name, const Su
 /// Signed volume of tetrahedron t (positive for the library's orientation).
 double tet_signed_volume(const Points& V, const Tetrahedra& T, Eigen::Index t);
 
+/// Mean length of the six edges of every tetrahedron (indices must be in range) [m].
+double mean_edge_length(const TetMesh& m);
+
 /// Flips every tetrahedron when all are negatively oriented (a file convention);
 /// returns true when it did. Mixed orientations are left for validate_tet_mesh to reject.
 bool orient_tets_positive(TetMesh& mesh);
