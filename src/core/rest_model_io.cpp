@@ -29,7 +29,8 @@ PhantomModel load_rest_model(const std::string& path) {
     validate_tet_mesh(t, "rest");
     return t;
   });
-  m.surface = boundary_surface(m.rest);
+  std::vector<int> boundary;  // tet vertex of every surface vertex
+  m.surface = boundary_surface(m.rest, &boundary);
   const long n = m.rest.V.rows();
   m.chest_wall = c.load("chest_wall", [&] {
     auto w = read_index_list(c.path_of(root["chest_wall"], "chest_wall"));
@@ -38,8 +39,6 @@ PhantomModel load_rest_model(const std::string& path) {
     return w;
   });
   c.load("landmarks", [&] {
-    std::vector<int> boundary;
-    boundary_surface(m.rest, &boundary);
     std::vector<char> on_boundary(n, 0);
     for (int v : boundary) on_boundary[v] = 1;
     for (const auto& [name, v] : read_named_indices(c.path_of(root["landmarks"], "landmarks"))) {
