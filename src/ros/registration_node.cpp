@@ -87,27 +87,29 @@ void RegistrationNode::load_scene() {
   try {
     if (params_.scene.empty()) throw InputError("parameter ~scene is not set (path of a scene YAML file)");
     const auto t0 = std::chrono::steady_clock::now();
-    scene_ = btr::load_scene(params_.scene);
+    Scene scene = btr::load_scene(params_.scene);
     std::vector<std::string> warnings;
-    model_ = prepare_model(*scene_, warnings);
+    RegistrationModel model = prepare_model(scene, warnings);
+    loaded_ = std::make_shared<const Simulation>(Simulation{std::move(scene), std::move(model)});
+    const Scene& s = loaded_->scene;
     for (const auto& w : warnings) ROS_WARN_STREAM("scene: " << w);
     simulation_for(preset_options(params_.preset));  // the default preset's simulation mesh, ready before any call
-    if (!scene_->prone_rigid) {
+    if (!s.prone_rigid) {
       ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
     } else {
       // The supine breast bulges over the chest skin next to it: track only the part clear of it.
-      tracked_region_ = rigid_region_clear_of(scene_->prone_rigid->V, boundary_surface(scene_->prone), params_.rigid_margin);
+      tracked_region_ = rigid_region_clear_of(s.prone_rigid->V, boundary_surface(s.prone), params_.rigid_margin);
       ROS_INFO("depth tracking on %ld of %ld chest-ring points (farther than %.0f mm from the breast)",
-               static_cast<long>(tracked_region_.rows()), static_cast<long>(scene_->prone_rigid->V.rows()),
+               static_cast<long>(tracked_region_.rows()), static_cast<long>(s.prone_rigid->V.rows()),
                params_.rigid_margin * 1e3);
     }
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ROS_INFO("loaded scene %s: %ld vertices, %ld tetrahedra, %zu tumours in %.2f s", params_.scene.c_str(),
-             static_cast<long>(model_->rest.V.rows()), static_cast<long>(model_->rest.T.rows()), model_->tumours.size(), s);
+             static_cast<long>(loaded_->model.rest.V.rows()), static_cast<long>(loaded_->model.rest.T.rows()),
+             loaded_->model.tumours.size(), seconds);
     publish_status(diagnostic_msgs::DiagnosticStatus::OK, "scene loaded; waiting for depth clouds");
   } catch (const std::exception& e) {
-    scene_.reset();
-    model_.reset();
+    loaded_.reset();
     simulations_.clear();
     scene_error_ = e.what();
     ROS_ERROR_STREAM("cannot load the scene: " << scene_error_ << " (the node keeps running; fix ~scene and restart)");
@@ -148,7 +150,7 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       Points region = tracked_region_.rows() >= 6 ? tracked_region_ : Points::Zero(6, 3);
       tracker_.emplace(region, params_.initial_model_pose, o);
     }
-    const bool track = model_ && scene_->prone_rigid && !registering_ && clouds_seen_ % params_.icp_every_n == 0;
+    const bool track = loaded_ && loaded_->scene.prone_rigid && !registering_ && clouds_seen_ % params_.icp_every_n == 0;
     TrackingResult r;
     if (track) {
       r = tracker_->process(c.points, T);
@@ -188,10 +190,10 @@ std::shared_ptr<const RegistrationNode::Simulation> RegistrationNode::simulation
   auto it = simulations_.find(opt.simulation_cell_size);
   if (it != simulations_.end()) return it->second;
   const auto t0 = std::chrono::steady_clock::now();
-  std::optional<Scene> coarse = simulation_scene(*scene_, opt);
+  std::optional<Scene> coarse = simulation_scene(loaded_->scene, opt);
   std::shared_ptr<const Simulation> sim;
   if (!coarse) {
-    sim = std::make_shared<Simulation>(Simulation{*scene_, *model_});
+    sim = loaded_;
   } else {
     std::vector<std::string> warnings;
     RegistrationModel m = prepare_model(*coarse, warnings);
@@ -199,7 +201,7 @@ std::shared_ptr<const RegistrationNode::Simulation> RegistrationNode::simulation
     const Scene& s = *coarse;
     ROS_INFO("simulation mesh for cell size %.1f mm: %ld tetrahedra (scene: %ld), prepared in %.2f s",
              opt.simulation_cell_size * 1e3, static_cast<long>(s.prone.T.rows()),
-             static_cast<long>(scene_->prone.T.rows()),
+             static_cast<long>(loaded_->scene.prone.T.rows()),
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     sim = std::make_shared<Simulation>(Simulation{std::move(*coarse), std::move(m)});
   }
@@ -216,7 +218,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     return true;
   }
   try {
-    if (!model_) throw InputError("the scene failed to load: " + scene_error_ + "; fix ~scene and restart the node");
+    if (!loaded_) throw InputError("the scene failed to load: " + scene_error_ + "; fix ~scene and restart the node");
     const std::string preset = req.preset.empty() ? params_.preset : req.preset;
     RegistrationOptions opt = preset_options(preset);
     const std::shared_ptr<const Simulation> sim = simulation_for(opt);

@@ -62,14 +62,14 @@ class RegistrationNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParameters params_;
-  // Cached model (built once at start-up) and, per simulation cell size a preset asks for,
-  // the scene and model it simulates on (built on first use, under registration_mutex_).
-  std::optional<Scene> scene_;
-  std::optional<RegistrationModel> model_;
+  // The scene as loaded with its model (built once at start-up; null when loading failed)
+  // and, per simulation cell size a preset asks for, the scene and model it simulates on
+  // (built on first use, under registration_mutex_; the loaded one when no remeshing is due).
   struct Simulation {
     Scene scene;
     RegistrationModel model;
   };
+  std::shared_ptr<const Simulation> loaded_;
   std::map<double, std::shared_ptr<const Simulation>> simulations_;
   std::shared_ptr<const Simulation> simulation_for(const RegistrationOptions& opt);
   std::string scene_error_;
