@@ -29,7 +29,8 @@ int main(int argc, char** argv) {
   app.add_option("--tumour-youngs-modulus", tumour_E, "give tumour elements this Young's modulus [Pa] (stiffer tumour)");
   app.add_option("--cell-size", cell_mm,
                  "simulate on the prone model re-tetrahedralized at this cell size [mm] (default: the preset's; 0: the "
-                 "scene's mesh as given)");
+                 "scene's mesh as given)")
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", quiet, "no progress display");
   CLI11_PARSE(app, argc, argv);
 
