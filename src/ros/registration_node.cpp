@@ -38,6 +38,7 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   pnh.param("use_landmarks", p.use_landmarks, p.use_landmarks);
   pnh.param("min_tracked_clouds", p.min_tracked_clouds, p.min_tracked_clouds);
   pnh.param("rigid_margin", p.rigid_margin, p.rigid_margin);
+  pnh.param("smoothing_clouds", p.smoothing_clouds, p.smoothing_clouds);
   p.roi_min = read_vec3(pnh, "roi_min", p.roi_min);
   p.roi_max = read_vec3(pnh, "roi_max", p.roi_max);
   std::vector<double> pose;
@@ -48,10 +49,11 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
     p.initial_model_pose.translation() = Vec3(pose[0], pose[1], pose[2]);
   }
   preset_options(p.preset);  // throws for an unknown preset
-  if (!(p.voxel_size > 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
-      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0))
-    throw InputError("parameters ~voxel_size, ~icp_max_correspondence, ~max_depth_edge must be > 0 and "
-                     "~icp_every_n, ~icp_max_iterations, ~min_tracked_clouds >= 1");
+  if (!(p.voxel_size >= 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
+      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0) || p.smoothing_clouds < 1)
+    throw InputError("parameters ~icp_max_correspondence, ~max_depth_edge must be > 0, ~voxel_size and "
+                     "~rigid_margin >= 0, and ~icp_every_n, ~icp_max_iterations, ~min_tracked_clouds, "
+                     "~smoothing_clouds >= 1");
   if ((p.roi_max - p.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
   return p;
 }
@@ -98,10 +100,9 @@ void RegistrationNode::load_scene() {
       ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
     } else {
       // The supine breast bulges over the chest skin next to it: track only the part clear of it.
-      tracked_region_ = rigid_region_clear_of(s.prone_rigid->V, boundary_surface(s.prone), params_.rigid_margin);
-      ROS_INFO("depth tracking on %ld of %ld chest-ring points (farther than %.0f mm from the breast)",
-               static_cast<long>(tracked_region_.rows()), static_cast<long>(s.prone_rigid->V.rows()),
-               params_.rigid_margin * 1e3);
+      tracked_region_ = rigid_region_samples(*s.prone_rigid, boundary_surface(s.prone), params_.rigid_margin, 0.002);
+      ROS_INFO("depth tracking on %ld samples of the chest ring (2 mm apart, farther than %.0f mm from the breast)",
+               static_cast<long>(tracked_region_->points.rows()), params_.rigid_margin * 1e3);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ROS_INFO("loaded scene %s: %ld vertices, %ld tetrahedra, %zu tumours in %.2f s", params_.scene.c_str(),
@@ -111,6 +112,7 @@ void RegistrationNode::load_scene() {
   } catch (const std::exception& e) {
     loaded_.reset();
     simulations_.clear();
+    tracked_region_.reset();
     scene_error_ = e.what();
     ROS_ERROR_STREAM("cannot load the scene: " << scene_error_ << " (the node keeps running; fix ~scene and restart)");
     publish_status(diagnostic_msgs::DiagnosticStatus::ERROR, "scene failed to load: " + scene_error_);
@@ -139,18 +141,18 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     }
     const Rigid T = ros_conv::from_transform(tf.transform);
     std::unique_lock<std::mutex> lock(state_mutex_);
-    if (!tracker_) {
+    if (!tracker_ && tracked_region_) {
       // Without a rigid region there is nothing to track; the cloud is still kept (ROI only).
       DepthTrackerOptions o;
       o.voxel_size = params_.voxel_size;
       o.max_iterations = params_.icp_max_iterations;
       o.max_correspondence = params_.icp_max_correspondence;
+      o.smoothing_clouds = params_.smoothing_clouds;
       o.roi_min = params_.roi_min;
       o.roi_max = params_.roi_max;
-      Points region = tracked_region_.rows() >= 6 ? tracked_region_ : Points::Zero(6, 3);
-      tracker_.emplace(region, params_.initial_model_pose, o);
+      tracker_.emplace(*tracked_region_, params_.initial_model_pose, o);
     }
-    const bool track = loaded_ && loaded_->scene.prone_rigid && !registering_ && clouds_seen_ % params_.icp_every_n == 0;
+    const bool track = tracker_ && !registering_ && clouds_seen_ % params_.icp_every_n == 0;
     TrackingResult r;
     if (track) {
       r = tracker_->process(c.points, T);
@@ -281,8 +283,10 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     const RegistrationResult r = run_registration(scene, sim->model, opt);
     publish_result(r, sim->model, preset, res.result);
     res.success = true;
-    res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")" +
-                  (r.converged ? "" : "; a step stopped without converging, try the accurate preset");
+    res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")";
+    for (const auto& step : r.reports)
+      if (!step.converged) res.message += "; the " + step.name + " step stopped without converging (" + step.stop_reason + ")";
+    if (!r.converged) res.message += "; the accurate preset runs longer";
     publish_status(r.converged ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN, res.message);
   } catch (const InputError& e) {
     res.success = false;

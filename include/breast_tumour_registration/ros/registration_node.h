@@ -31,7 +31,7 @@ struct NodeParameters {
   std::string working_frame = "world";    ///< ~working_frame: frame of the results
   std::string model_frame = "breast_model";  ///< ~model_frame: the prone model's frame (tf child)
   std::string preset = "balanced";        ///< ~preset
-  double voxel_size = 0.004;              ///< ~voxel_size [m] for tracking ICP
+  double voxel_size = 0.002;              ///< ~voxel_size [m]: cloud downsampling for tracking ICP (0: none)
   Vec3 roi_min = Vec3::Constant(-1e9), roi_max = Vec3::Constant(1e9);  ///< ~roi_min/~roi_max [m], working frame
   int icp_every_n = 1;                    ///< ~icp_every_n: track on every n-th cloud
   int icp_max_iterations = 10;            ///< ~icp_max_iterations per cloud (warm-started)
@@ -41,6 +41,7 @@ struct NodeParameters {
   bool use_landmarks = true;              ///< ~use_landmarks with the live cloud
   int min_tracked_clouds = 10;            ///< ~min_tracked_clouds: consecutive ICP successes before registering
   double rigid_margin = 0.015;            ///< ~rigid_margin [m]: track chest-ring points this far from the breast
+  int smoothing_clouds = 10;              ///< ~smoothing_clouds: the published pose is the mean of this many (1: none)
 };
 
 /// Reads the parameters with defaults; throws InputError naming a parameter out of range.
@@ -79,7 +80,7 @@ class RegistrationNode {
   int latest_width_ = 0, latest_height_ = 0;
   bool have_cloud_ = false;
   std::optional<DepthTracker> tracker_;
-  Points tracked_region_;  ///< the rigid region clear of the breast (model frame)
+  std::optional<SurfaceSamples> tracked_region_;  ///< the rigid region clear of the breast (model frame)
   long clouds_seen_ = 0;
   // Registration runs one at a time; a second request gets an answer, not a deadlock.
   std::mutex registration_mutex_;
