@@ -4,6 +4,8 @@
 #include <pcl/point_types.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <map>
 #include <vector>
 
 #include "breast_tumour_registration/core/closest_point.h"
@@ -14,14 +16,39 @@ namespace {
 
 class MeshProjector : public SurfaceProjector {
  public:
-  explicit MeshProjector(const SurfaceMesh& m) : cp_(m.V, m.F) {}
+  explicit MeshProjector(const SurfaceMesh& m) : cp_(m.V, m.F), V_(m.V), F_(m.F), border_(m.F.rows(), 0) {
+    // Border edges: used by one triangle only. border_[f] bit k: the edge opposite corner k.
+    std::map<std::pair<int, int>, int> uses;
+    const auto edge = [&](Eigen::Index f, int k) {
+      const int a = F_(f, (k + 1) % 3), b = F_(f, (k + 2) % 3);
+      return std::make_pair(std::min(a, b), std::max(a, b));
+    };
+    for (Eigen::Index f = 0; f < F_.rows(); ++f)
+      for (int k = 0; k < 3; ++k) ++uses[edge(f, k)];
+    for (Eigen::Index f = 0; f < F_.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        if (uses[edge(f, k)] == 1) border_[f] |= static_cast<unsigned char>(1 << k);
+  }
   Projection project(const Vec3& p) const override {
     const ClosestPoint c = cp_.query(p);
-    return {c.point, cp_.face_normal(c.face), c.distance};
+    Projection out{c.point, cp_.face_normal(c.face), c.distance, false};
+    if (border_[c.face]) {
+      for (int k = 0; k < 3 && !out.on_boundary; ++k) {
+        if (!(border_[c.face] & (1 << k))) continue;
+        const Vec3 a = V_.row(F_(c.face, (k + 1) % 3)), b = V_.row(F_(c.face, (k + 2) % 3));
+        const double len2 = (b - a).squaredNorm();
+        const double t = len2 > 0 ? std::clamp((c.point - a).dot(b - a) / len2, 0.0, 1.0) : 0.0;
+        out.on_boundary = (a + t * (b - a) - c.point).squaredNorm() <= 1e-12 * std::max(len2, 1e-12);
+      }
+    }
+    return out;
   }
 
  private:
   SurfaceClosestPoint cp_;
+  Points V_;
+  Triangles F_;
+  std::vector<unsigned char> border_;
 };
 
 class CloudProjector : public SurfaceProjector {

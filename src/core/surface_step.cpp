@@ -47,20 +47,25 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       const int v = model.skin[i];
       const Projection c = supine.project(x.row(v).transpose());
       const double m = (c.point - targets.row(i).transpose()).norm();
-      moved = std::max(moved, m);
-      moved_sq += m * m;
       targets.row(i) = c.point.transpose();
       if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) continue;
+      if (opt.reject_boundary && c.on_boundary) continue;
+      // Convergence is judged on the constraints that act (a dropped projection onto a
+      // scan's border slides along it as the skin moves).
+      moved = std::max(moved, m);
+      moved_sq += m * m;
       points->add(Anchor::vertex(v), c.point);
       planes->add(Anchor::vertex(v), c.point, c.normal);
       ++kept;
     }
-    const double moved_rms = std::sqrt(moved_sq / static_cast<double>(model.skin.size()));
+    const double moved_rms = kept ? std::sqrt(moved_sq / kept) : 0.0;
     rep.t_projection += std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
     rep.projection_rms_change = moved_rms;
+    rep.constrained_skin = kept;
+    rep.skin_vertices = static_cast<int>(model.skin.size());
     rep.projection_max_change = moved;
     if (kept == 0)
-      throw InputError("surface step: no skin vertex is within " + std::to_string(opt.max_projection_distance) +
+      throw InputError("surface step: no skin vertex projects inside the supine surface within " + std::to_string(opt.max_projection_distance) +
                        " m of the supine surface; is the scan aligned with the model?");
     if (callback) nopt.callback = [&](const IterationInfo& it) {
       IterationInfo shifted = it;

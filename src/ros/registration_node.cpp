@@ -284,8 +284,12 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     publish_result(r, sim->model, preset, res.result);
     res.success = true;
     res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")";
-    for (const auto& step : r.reports)
+    for (const auto& step : r.reports) {
+      if (step.skin_vertices > 0)
+        res.message += "; " + std::to_string(step.constrained_skin) + " of " + std::to_string(step.skin_vertices) +
+                       " skin vertices held to the scan";
       if (!step.converged) res.message += "; the " + step.name + " step stopped without converging (" + step.stop_reason + ")";
+    }
     if (!r.converged) res.message += "; the accurate preset runs longer";
     publish_status(r.converged ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN, res.message);
   } catch (const InputError& e) {

@@ -12,6 +12,7 @@
 #include "breast_tumour_registration/core/phantom_scene.h"
 #include "breast_tumour_registration/core/registration_report.h"
 #include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/core/surface_projector.h"
 #include "breast_tumour_registration/core/simulation_mesh.h"
 #include "breast_tumour_registration/core/skinning_subspace.h"
 #include "test_util.h"
@@ -395,4 +396,51 @@ TEST(SimulationMesh, ACoarserMeshKeepsChestWallLandmarksAndAccuracy) {
     EXPECT_LT(t.centroid_distance, 0.5 * t.rigid_centroid_distance) << t.name;
   }
   expect_throw_with<InputError>([&] { with_simulation_mesh(scene, -1); }, "must be positive");
+}
+
+TEST(SurfaceProjector, FlagsClosestPointsOnTheBorderOfAnOpenSurface) {
+  // Two triangles forming the unit square in z = 0: open, its four sides are border.
+  SurfaceMesh sq;
+  sq.V.resize(4, 3);
+  sq.V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  sq.F.resize(2, 3);
+  sq.F << 0, 1, 2, 0, 2, 3;
+  const auto open = make_mesh_projector(sq);
+  EXPECT_FALSE(open->project(Vec3(0.5, 0.4, 0.3)).on_boundary);  // above the inside
+  EXPECT_FALSE(open->project(Vec3(0.5, 0.5, 0.1)).on_boundary);  // above the shared diagonal
+  EXPECT_TRUE(open->project(Vec3(1.5, 0.5, 0.1)).on_boundary);   // beyond a side
+  EXPECT_TRUE(open->project(Vec3(-0.2, -0.3, 0.0)).on_boundary); // beyond a corner
+  // A closed surface has no border.
+  const auto closed = make_mesh_projector(make_icosphere(Vec3::Zero(), 1.0, 2));
+  for (const Vec3& p : {Vec3(2, 0, 0), Vec3(0.1, 0.2, 0.3), Vec3(-1, 1, 1)}) EXPECT_FALSE(closed->project(p).on_boundary);
+}
+
+TEST(Registration, APartialScanIsNotPulledOntoItsBorder) {
+  // The supine surface as a depth camera would leave it: one side of the breast missing.
+  // Skin hidden from the scan must not be held to the scan's edge.
+  const Scene base = load_scene(phantom_dir() + "/scene.yaml");
+  SurfaceMesh partial = *base.supine_surface;
+  std::vector<Eigen::Vector3i> kept;
+  for (Eigen::Index f = 0; f < partial.F.rows(); ++f) {
+    Vec3 c = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) c += partial.V.row(partial.F(f, k)).transpose() / 3;
+    if (c.y() < 0.03) kept.push_back(partial.F.row(f).transpose());
+  }
+  ASSERT_LT(kept.size(), static_cast<size_t>(partial.F.rows()));
+  partial.F.resize(static_cast<Eigen::Index>(kept.size()), 3);
+  for (size_t i = 0; i < kept.size(); ++i) partial.F.row(static_cast<Eigen::Index>(i)) = kept[i].transpose();
+  Scene s = base;
+  s.supine_surface = partial;
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(s, warnings);
+  RegistrationOptions with = preset_options("balanced"), without = with;
+  without.surface.reject_boundary = false;
+  const RegistrationResult a = run_registration(s, m, with), b = run_registration(s, m, without);
+  const StepReport& surface = a.reports.back();
+  EXPECT_EQ(surface.name, "surface");
+  EXPECT_LT(surface.constrained_skin, surface.skin_vertices);  // the hidden side is left free
+  EXPECT_LT(worst_error(a), 1.0e-3);
+  EXPECT_LT(worst_error(a), worst_error(b));
+  std::printf("partial scan: worst tumour error %.3f mm with border rejection, %.3f mm without\n", worst_error(a) * 1e3,
+              worst_error(b) * 1e3);
 }

@@ -66,6 +66,9 @@ struct StepReport {
   double gradient_norm = 0;
   double projection_rms_change = 0;  ///< surface step: last RMS change of the projections [m]
   double projection_max_change = 0;  ///< surface step: last max change [m]
+  /// surface step: skin vertices constrained by the last projection (the others were too
+  /// far from the supine surface or projected onto its border) and all skin vertices
+  int constrained_skin = 0, skin_vertices = 0;
   /// Where the time went [s]: setup (energies, subspace, symbolic analysis), Hessian
   /// assembly, numeric factorizations, linear solves (PCG included), line search and the
   /// surface projections; with the number of factorizations and PCG iterations.

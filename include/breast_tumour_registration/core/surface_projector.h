@@ -13,6 +13,10 @@ struct Projection {
   Vec3 point;        ///< closest point [m]
   Vec3 normal;       ///< unit surface normal there (sign irrelevant for point-to-plane)
   double distance;   ///< [m]
+  /// The closest point lies on the border of an open surface (a scan's edge or hole):
+  /// the true partner of the query is then most likely not in the scan at all (hidden from
+  /// the camera), so the constraint would pull it to the border.
+  bool on_boundary = false;
 };
 
 class SurfaceProjector {
@@ -21,7 +25,8 @@ class SurfaceProjector {
   virtual Projection project(const Vec3& p) const = 0;
 };
 
-/// Projector onto a triangle mesh (face normals).
+/// Projector onto a triangle mesh (face normals); flags closest points on its border
+/// edges (edges of a single triangle).
 std::unique_ptr<SurfaceProjector> make_mesh_projector(const SurfaceMesh& mesh);
 /// Projector onto a point cloud: nearest point, normal from the PCA of its `neighbours`
 /// nearest points. Throws InputError for fewer than neighbours + 1 points or NaN points.

@@ -25,6 +25,9 @@ struct SurfaceStepOptions {
   double budget_tolerance = 1e-4;
   /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
   double max_projection_distance = 0.03;
+  /// Projections onto the border of an open supine surface (the edge of a depth scan, the
+  /// rim of a hole behind an occlusion) are dropped: that skin is not in the scan.
+  bool reject_boundary = true;
   NewtonOptions newton;
 };
 
