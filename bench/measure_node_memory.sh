@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Resident memory of the registration node while a depth bag (640 x 480 at 30 Hz) is replayed
 # in a loop: one sample after about 100 clouds and then every 1000, up to CLOUDS clouds
-# (time-based: the bag plays at 30 Hz). Every cloud is filtered and tracked (ICP).
+# (time-based: the bag plays at 30 Hz). Every cloud is filtered and tracked (ICP); the
+# per-cloud processing times the node logs are printed at the end.
 # Usage: bash bench/measure_node_memory.sh [clouds]   (after scripts/setup.sh; makes its own scene and bag)
 set -euo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -40,3 +41,11 @@ for target in 100 $(seq 1000 1000 "$CLOUDS"); do
   hwm=$(awk '/VmHWM/ {printf "%.1f", $2/1024}' /proc/$PID/status)
   echo "| $target | $rss | $hwm |"
 done
+echo
+echo "Per-cloud processing time in the node (PointCloud2 conversion, filtering and ICP; the tf wait"
+echo "excluded), as the node logs it every 300 tracked clouds: wall time, and CPU time of the"
+echo "callback thread (without the time the bag player and the master took the cores):"
+echo
+echo '```'
+grep -o "depth tracking per cloud.*percentile" "$WORK/node.log" || echo "(no timing line in $WORK/node.log)"
+echo '```'

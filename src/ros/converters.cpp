@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "breast_tumour_registration/core/errors.h"
 
@@ -29,13 +30,19 @@ CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan) {
   out.organized = msg.height > 1;
   const bool organized_keep = keep_nan && out.organized;
   out.points.resize(static_cast<Eigen::Index>(n), 3);
+  double* dst = out.points.data();  // row-major: x y z of each point in a row
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const bool all_float = f[0]->datatype == sensor_msgs::PointField::FLOAT32 &&
+                         f[1]->datatype == sensor_msgs::PointField::FLOAT32 &&
+                         f[2]->datatype == sensor_msgs::PointField::FLOAT32;
   Eigen::Index k = 0;
-  for (uint32_t r = 0; r < msg.height; ++r)
+  for (uint32_t r = 0; r < msg.height; ++r) {
+    const uint8_t* row = msg.data.data() + static_cast<size_t>(r) * msg.row_step;
     for (uint32_t c = 0; c < msg.width; ++c) {
-      const uint8_t* base = msg.data.data() + r * msg.row_step + c * msg.point_step;
+      const uint8_t* base = row + static_cast<size_t>(c) * msg.point_step;
       double v[3];
       for (int i = 0; i < 3; ++i) {
-        if (f[i]->datatype == sensor_msgs::PointField::FLOAT32) {
+        if (all_float || f[i]->datatype == sensor_msgs::PointField::FLOAT32) {
           float x;
           std::memcpy(&x, base + f[i]->offset, 4);
           v[i] = x;
@@ -46,9 +53,12 @@ CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan) {
       const bool finite = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
       out.finite += finite;
       if (!finite && !organized_keep) continue;
-      const double nan = std::numeric_limits<double>::quiet_NaN();
-      out.points.row(k++) << (finite ? v[0] : nan), (finite ? v[1] : nan), (finite ? v[2] : nan);
+      double* o = dst + 3 * k++;
+      o[0] = finite ? v[0] : nan;
+      o[1] = finite ? v[1] : nan;
+      o[2] = finite ? v[2] : nan;
     }
+  }
   out.points.conservativeResize(k, 3);
   if (!organized_keep) out.organized = false;
   return out;

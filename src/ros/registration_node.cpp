@@ -4,6 +4,9 @@
 #include <shape_msgs/Mesh.h>
 #include <visualization_msgs/Marker.h>
 
+#include <time.h>
+
+#include <algorithm>
 #include <chrono>
 
 #include "breast_tumour_registration/RegistrationResult.h"
@@ -20,6 +23,13 @@ Vec3 read_vec3(const ros::NodeHandle& pnh, const std::string& name, const Vec3& 
   if (!pnh.getParam(name, v)) return def;
   if (v.size() != 3) throw InputError("parameter ~" + name + " must be a list of 3 numbers");
   return Vec3(v[0], v[1], v[2]);
+}
+
+/// CPU time of the calling thread [s] (excludes time the thread waited or was preempted).
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
 }  // namespace
@@ -129,16 +139,21 @@ void RegistrationNode::publish_status(uint8_t level, const std::string& message)
 }
 
 void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  using Clock = std::chrono::steady_clock;
+  const auto t_start = Clock::now();
+  const double cpu_start = thread_cpu_seconds();
   try {
     ros_conv::CloudPoints c = ros_conv::from_cloud(*msg, true);
     if (c.points.rows() == 0) throw InputError("empty point cloud");
     if (c.finite == 0) throw InputError("point cloud has no finite point (all NaN)");
     geometry_msgs::TransformStamped tf;
+    const auto t_tf = Clock::now();
     try {
       tf = tf_buffer_.lookupTransform(params_.working_frame, msg->header.frame_id, msg->header.stamp, ros::Duration(0.05));
     } catch (const tf2::TransformException& e) {
       throw InputError("no transform from '" + msg->header.frame_id + "' to '" + params_.working_frame + "': " + e.what());
     }
+    const double tf_wait = std::chrono::duration<double>(Clock::now() - t_tf).count();
     const Rigid T = ros_conv::from_transform(tf.transform);
     std::unique_lock<std::mutex> lock(state_mutex_);
     if (!tracker_ && tracked_region_) {
@@ -173,6 +188,20 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       return;
     }
     const Rigid pose = *tracker_->pose();
+    // Per-cloud processing time (conversion, filtering, ICP; not the wait for tf), logged
+    // as median and 95th percentile every 300 tracked clouds.
+    cloud_seconds_.push_back(std::chrono::duration<double>(Clock::now() - t_start).count() - tf_wait);
+    cloud_cpu_seconds_.push_back(thread_cpu_seconds() - cpu_start);
+    if (cloud_seconds_.size() == 300) {
+      std::sort(cloud_seconds_.begin(), cloud_seconds_.end());
+      std::sort(cloud_cpu_seconds_.begin(), cloud_cpu_seconds_.end());
+      ROS_INFO("depth tracking per cloud over the last 300 (conversion, filtering and ICP): wall %.1f ms median, "
+               "%.1f ms 95th percentile; CPU of the callback thread %.1f ms median, %.1f ms 95th percentile",
+               1e3 * cloud_seconds_[150], 1e3 * cloud_seconds_[284], 1e3 * cloud_cpu_seconds_[150],
+               1e3 * cloud_cpu_seconds_[284]);
+      cloud_seconds_.clear();
+      cloud_cpu_seconds_.clear();
+    }
     lock.unlock();
     geometry_msgs::TransformStamped out;
     out.header.stamp = msg->header.stamp;

@@ -82,6 +82,8 @@ class RegistrationNode {
   std::optional<DepthTracker> tracker_;
   std::optional<SurfaceSamples> tracked_region_;  ///< the rigid region clear of the breast (model frame)
   long clouds_seen_ = 0;
+  std::vector<double> cloud_seconds_;      ///< wall time of recent tracked clouds [s]
+  std::vector<double> cloud_cpu_seconds_;  ///< their callback thread's CPU time [s]
   // Registration runs one at a time; a second request gets an answer, not a deadlock.
   std::mutex registration_mutex_;
   std::atomic<bool> registering_{false};  ///< tracking pauses meanwhile: both would share two cores
