@@ -34,11 +34,7 @@ static long rss_kib() {
 }
 
 static Rigid pose(double x, double y, double z, double roll, double pitch, double yaw) {
-  Rigid T = Rigid::Identity();
-  T.linear() = (Eigen::AngleAxisd(yaw, Vec3::UnitZ()) * Eigen::AngleAxisd(pitch, Vec3::UnitY()) *
-                Eigen::AngleAxisd(roll, Vec3::UnitX())).toRotationMatrix();
-  T.translation() = Vec3(x, y, z);
-  return T;
+  return rigid_from_rpy(Vec3(x, y, z), Vec3(roll, pitch, yaw));
 }
 
 int main(int argc, char** argv) {
@@ -89,12 +85,8 @@ int main(int argc, char** argv) {
     };
     auto error = [&](const Rigid& T) {
       const Rigid e = T * T_wp.inverse();
-      double worst = 0;
-      for (Eigen::Index i = 0; i < region.points.rows(); ++i) {
-        const Vec3 p = region.points.row(i).transpose();
-        worst = std::max(worst, (T * p - T_wp * p).norm());
-      }
-      return PoseError{rotation_angle(e) * 180 / M_PI, e.translation().norm() * 1e3, worst * 1e3};
+      return PoseError{rotation_angle(e) * 180 / M_PI, e.translation().norm() * 1e3,
+                       max_displacement(T, T_wp, region.points) * 1e3};
     };
 
     std::printf("| first alignment from | accepted after [clouds] | time of that cloud [ms] | its error: rot [deg] / trans [mm] / region max [mm] | within 0.5 deg and 0.5 mm on the region after [clouds] (processing time [ms]) | after 30 clouds: rot [deg] / trans [mm] / region max [mm] |\n|---|---|---|---|---|---|\n");

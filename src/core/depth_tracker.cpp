@@ -18,6 +18,24 @@ long long voxel_key(const Vec3& p, double h) {
   return (x << 42) | (y << 21) | z;
 }
 constexpr double kCoverageCell = 0.01;  // [m]
+
+void sort_unique(std::vector<long long>& keys) {
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+/// The options, after checking every one (before anything is built from them).
+const DepthTrackerOptions& checked(const DepthTrackerOptions& o) {
+  if ((o.roi_max - o.roi_min).minCoeff() <= 0) throw InputError("depth tracking: roi_max must exceed roi_min");
+  if (!(o.voxel_size >= 0) || !(o.refine_voxel_size >= 0) || !(o.capture_voxel_size >= 0) || o.max_iterations < 1 ||
+      o.refine_rounds < 0 || o.refine_iterations < 1 || o.capture_iterations < 1 || !(o.max_correspondence > 0))
+    throw InputError("depth tracking: voxel sizes must be >= 0, iteration counts >= 1 and max_correspondence > 0");
+  if (o.smoothing_clouds < 1 || !(o.motion_gate > 0))
+    throw InputError("depth tracking: smoothing_clouds must be >= 1 and motion_gate > 0");
+  if (!(o.min_coverage >= 0 && o.min_coverage <= 1) || o.lost_after < 1)
+    throw InputError("depth tracking: min_coverage must be in [0, 1] and lost_after >= 1");
+  return o;
+}
 }  // namespace
 
 Points to_working_frame(Points& cloud, const Rigid& sensor_to_working, const Vec3& roi_min, const Vec3& roi_max) {
@@ -83,25 +101,16 @@ SurfaceSamples rigid_region_samples(const SurfaceMesh& region, const SurfaceMesh
 
 DepthTracker::DepthTracker(SurfaceSamples region, const Rigid& initial, const DepthTrackerOptions& opt)
     : region_(std::move(region)),
-      target_(region_.points, region_.normals, opt.lookup_cell, opt.max_correspondence + std::max(0.0, opt.lookup_cell)),
+      target_(region_.points, region_.normals, checked(opt).lookup_cell, opt.max_correspondence + std::max(0.0, opt.lookup_cell)),
       guess_(initial),
       opt_(opt) {
-  if ((opt_.roi_max - opt_.roi_min).minCoeff() <= 0) throw InputError("depth tracking: roi_max must exceed roi_min");
-  if (!(opt_.voxel_size >= 0) || !(opt_.refine_voxel_size >= 0) || !(opt_.capture_voxel_size >= 0) || opt_.max_iterations < 1 || opt_.refine_rounds < 0 ||
-      opt_.refine_iterations < 1 || opt_.capture_iterations < 1 || !(opt_.max_correspondence > 0))
-    throw InputError("depth tracking: voxel sizes must be >= 0, iteration counts >= 1 and max_correspondence > 0");
-  if (opt_.smoothing_clouds < 1 || !(opt_.motion_gate > 0))
-    throw InputError("depth tracking: smoothing_clouds must be >= 1 and motion_gate > 0");
   const Vec3 lo = region_.points.colwise().minCoeff().transpose(), hi = region_.points.colwise().maxCoeff().transpose();
   corners_.resize(8, 3);
   for (int c = 0; c < 8; ++c)
     corners_.row(c) << (c & 1 ? hi : lo).x(), (c & 2 ? hi : lo).y(), (c & 4 ? hi : lo).z();
-  if (!(opt_.min_coverage >= 0 && opt_.min_coverage <= 1) || opt_.lost_after < 1)
-    throw InputError("depth tracking: min_coverage must be in [0, 1] and lost_after >= 1");
   for (Eigen::Index i = 0; i < region_.points.rows(); ++i)
     region_cells_.push_back(voxel_key(region_.points.row(i).transpose(), kCoverageCell));
-  std::sort(region_cells_.begin(), region_cells_.end());
-  region_cells_.erase(std::unique(region_cells_.begin(), region_cells_.end()), region_cells_.end());
+  sort_unique(region_cells_);
   if (opt_.region_band > 0) {
     // Voxels of the region's samples, dilated by one voxel.
     const double h = opt_.region_band;
@@ -110,8 +119,7 @@ DepthTracker::DepthTracker(SurfaceSamples region, const Rigid& initial, const De
         for (int dy = -1; dy <= 1; ++dy)
           for (int dz = -1; dz <= 1; ++dz)
             region_voxels_.push_back(voxel_key(Vec3(region_.points.row(i).transpose()) + h * Vec3(dx, dy, dz), h));
-    std::sort(region_voxels_.begin(), region_voxels_.end());
-    region_voxels_.erase(std::unique(region_voxels_.begin(), region_voxels_.end()), region_voxels_.end());
+    sort_unique(region_voxels_);
   }
 }
 
@@ -136,23 +144,14 @@ double DepthTracker::coverage(const Points& near, const Rigid& model_to_working)
     const long long k = voxel_key(to_model * Vec3(near.row(i).transpose()), kCoverageCell);
     if (std::binary_search(region_cells_.begin(), region_cells_.end(), k)) hit.push_back(k);
   }
-  std::sort(hit.begin(), hit.end());
-  const auto distinct = std::unique(hit.begin(), hit.end()) - hit.begin();
-  return static_cast<double>(distinct) / region_cells_.size();
+  sort_unique(hit);
+  return static_cast<double>(hit.size()) / region_cells_.size();
 }
 
 bool DepthTracker::smooth(const Rigid& latest) {
-  bool restart = false;
-  if (pose_) {
-    // A rigid motion's largest displacement over the region is at a corner of its hull,
-    // so the bounding-box corners bound it from above.
-    double moved = 0;
-    for (Eigen::Index c = 0; c < corners_.rows(); ++c) {
-      const Vec3 p = corners_.row(c).transpose();
-      moved = std::max(moved, (latest * p - *pose_ * p).norm());
-    }
-    restart = moved > opt_.motion_gate;
-  }
+  // A rigid motion's largest displacement over the region is at a corner of its hull, so
+  // the bounding-box corners bound it from above.
+  const bool restart = pose_ && max_displacement(latest, *pose_, corners_) > opt_.motion_gate;
   if (restart) window_.clear();
   window_.push_back(latest);
   while (static_cast<int>(window_.size()) > opt_.smoothing_clouds) window_.pop_front();

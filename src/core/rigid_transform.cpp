@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/core/rigid_transform.h"
 
+#include <algorithm>
+
 #include <Eigen/SVD>
 #include <cmath>
 
@@ -36,5 +38,23 @@ Points transform_points(const Rigid& T, const Points& P) {
 SurfaceMesh transform_surface(const Rigid& T, const SurfaceMesh& s) { return {transform_points(T, s.V), s.F}; }
 
 double rotation_angle(const Rigid& T) { return Eigen::AngleAxisd(T.rotation()).angle(); }
+
+Rigid rigid_from_rpy(const Vec3& translation, const Vec3& roll_pitch_yaw) {
+  Rigid T = Rigid::Identity();
+  T.linear() = (Eigen::AngleAxisd(roll_pitch_yaw.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(roll_pitch_yaw.y(), Vec3::UnitY()) *
+                Eigen::AngleAxisd(roll_pitch_yaw.x(), Vec3::UnitX()))
+                   .toRotationMatrix();
+  T.translation() = translation;
+  return T;
+}
+
+double max_displacement(const Rigid& A, const Rigid& B, const Points& P) {
+  double worst = 0;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    const Vec3 p = P.row(i).transpose();
+    worst = std::max(worst, (A * p - B * p).norm());
+  }
+  return worst;
+}
 
 }  // namespace btr

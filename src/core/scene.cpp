@@ -18,12 +18,7 @@ namespace btr {
 namespace fs = std::filesystem;
 
 Rigid misalignment_from_degrees_mm(const Vec3& rotation_deg, const Vec3& translation_mm) {
-  const Vec3 rot = rotation_deg * M_PI / 180.0;
-  Rigid m = Rigid::Identity();
-  m.linear() = (Eigen::AngleAxisd(rot.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rot.y(), Vec3::UnitY()) *
-                Eigen::AngleAxisd(rot.x(), Vec3::UnitX())).toRotationMatrix();
-  m.translation() = translation_mm * 1e-3;
-  return m;
+  return rigid_from_rpy(translation_mm * 1e-3, rotation_deg * M_PI / 180.0);
 }
 
 void apply_misalignment(Scene& s, const Rigid& m) {

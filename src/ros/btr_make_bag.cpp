@@ -40,11 +40,7 @@ int main(int argc, char** argv) {
     if (frames < 1) throw InputError("--frames must be >= 1");
     const Scene scene = load_scene(scene_path);
     if (!scene.supine_surface) throw InputError(scene_path + ": field 'supine.surface' is needed to render a depth scan");
-    Rigid T_wp = Rigid::Identity();
-    const double d2r = M_PI / 180;
-    T_wp.linear() = (Eigen::AngleAxisd(pose[5] * d2r, Vec3::UnitZ()) * Eigen::AngleAxisd(pose[4] * d2r, Vec3::UnitY()) *
-                     Eigen::AngleAxisd(pose[3] * d2r, Vec3::UnitX())).toRotationMatrix();
-    T_wp.translation() = Vec3(pose[0], pose[1], pose[2]);
+    const Rigid T_wp = rigid_from_rpy(Vec3(pose[0], pose[1], pose[2]), Vec3(pose[3], pose[4], pose[5]) * M_PI / 180);
     std::vector<SurfaceMesh> world_surfaces = {transform_surface(T_wp, *scene.supine_surface)};
     if (scene.supine_rigid) world_surfaces.push_back(transform_surface(T_wp, *scene.supine_rigid));
     std::vector<const SurfaceMesh*> ptrs;

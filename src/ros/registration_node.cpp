@@ -54,9 +54,7 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   std::vector<double> pose;
   if (pnh.getParam("initial_model_pose", pose)) {
     if (pose.size() != 6) throw InputError("parameter ~initial_model_pose must be [x, y, z, roll, pitch, yaw]");
-    p.initial_model_pose.linear() = (Eigen::AngleAxisd(pose[5], Vec3::UnitZ()) * Eigen::AngleAxisd(pose[4], Vec3::UnitY()) *
-                                     Eigen::AngleAxisd(pose[3], Vec3::UnitX())).toRotationMatrix();
-    p.initial_model_pose.translation() = Vec3(pose[0], pose[1], pose[2]);
+    p.initial_model_pose = rigid_from_rpy(Vec3(pose[0], pose[1], pose[2]), Vec3(pose[3], pose[4], pose[5]));
   }
   preset_options(p.preset);  // throws for an unknown preset
   if (!(p.voxel_size >= 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||

@@ -14,18 +14,10 @@
 
 using namespace btr;
 using btr::test::expect_throw_with;
+using btr::test::make_rigid;
 
 namespace {
 
-Rigid pose(const Vec3& rot_deg, const Vec3& trans) {
-  Rigid T = Rigid::Identity();
-  T.linear() = (Eigen::AngleAxisd(rot_deg.z() * M_PI / 180, Vec3::UnitZ()) *
-                Eigen::AngleAxisd(rot_deg.y() * M_PI / 180, Vec3::UnitY()) *
-                Eigen::AngleAxisd(rot_deg.x() * M_PI / 180, Vec3::UnitX()))
-                    .toRotationMatrix();
-  T.translation() = trans;
-  return T;
-}
 
 // A breast dome on its chest ring, seen by a 320 x 240 depth camera with 1 mm noise.
 struct TrackingScene {
@@ -54,14 +46,7 @@ struct TrackingScene {
     return out;
   }
   // Largest displacement of a rigid-region sample between two poses [m].
-  double region_error(const Rigid& A, const Rigid& B) const {
-    double worst = 0;
-    for (Eigen::Index i = 0; i < region.points.rows(); ++i) {
-      const Vec3 p = region.points.row(i).transpose();
-      worst = std::max(worst, (A * p - B * p).norm());
-    }
-    return worst;
-  }
+  double region_error(const Rigid& A, const Rigid& B) const { return max_displacement(A, B, region.points); }
 };
 
 }  // namespace
@@ -99,7 +84,7 @@ TEST(NearestSampleGrid, AnswersWithinACellOfTheTrueNearestSample) {
 
 TEST(IcpTarget, GridAndKdTreeAgreeAndBadTargetsAreRefused) {
   TrackingScene s;
-  const Rigid T = pose(Vec3(2, -1.5, 3), Vec3(0.003, -0.002, 0.002));  // working -> model
+  const Rigid T = make_rigid(Vec3(2, -1.5, 3), Vec3(0.003, -0.002, 0.002));  // working -> model
   const Points source = transform_points(T.inverse(), s.region.points);
   IcpOptions o;
   o.voxel_size = 0;
@@ -130,10 +115,10 @@ TEST(RigidRegionSamples, KeepOnlyTheChestSkinClearOfTheBreast) {
 
 TEST(DepthTracker, CapturesFromALargeOffsetAndSmoothsToSubMillimetre) {
   TrackingScene s;
-  const Rigid truth = pose(Vec3(0, 0, 20), Vec3(0.1, -0.05, 0.75));
+  const Rigid truth = make_rigid(Vec3(0, 0, 20), Vec3(0.1, -0.05, 0.75));
   std::vector<Points> clouds = s.clouds(truth, 12, 1);
   DepthTrackerOptions o;
-  DepthTracker tracker(s.region, truth * pose(Vec3(0, 0, 15), Vec3(0.01, 0, 0)), o);  // 15 deg and 10 mm off
+  DepthTracker tracker(s.region, truth * make_rigid(Vec3(0, 0, 15), Vec3(0.01, 0, 0)), o);  // 15 deg and 10 mm off
   TrackingResult r = tracker.process(clouds[0], s.camera_to_world);
   ASSERT_TRUE(r.accepted) << r.icp.message;
   EXPECT_TRUE(r.captured);
@@ -156,13 +141,13 @@ TEST(DepthTracker, CapturesFromALargeOffsetAndSmoothsToSubMillimetre) {
 
 TEST(DepthTracker, FollowsAMovingPatientAndRecapturesWhenLost) {
   TrackingScene s;
-  const Rigid truth = pose(Vec3(0, 0, 20), Vec3(0.1, -0.05, 0.75));
+  const Rigid truth = make_rigid(Vec3(0, 0, 20), Vec3(0.1, -0.05, 0.75));
   DepthTrackerOptions o;
   DepthTracker tracker(s.region, truth, o);
   for (Points& c : s.clouds(truth, 4, 2)) ASSERT_TRUE(tracker.process(c, s.camera_to_world).accepted);
   // The patient shifts by 4 mm and turns by 1 deg (the camera stays where it was).
   const Rigid camera = s.camera_to_world;
-  const Rigid moved = pose(Vec3(0, 0, 21), Vec3(0.104, -0.05, 0.75));
+  const Rigid moved = make_rigid(Vec3(0, 0, 21), Vec3(0.104, -0.05, 0.75));
   std::vector<Points> after = s.clouds(moved, 4, 3);
   bool motion = false;
   for (Points& c : after) {
@@ -178,7 +163,7 @@ TEST(DepthTracker, FollowsAMovingPatientAndRecapturesWhenLost) {
   // Far away: the cloud reaches a sliver of the region under the tracked pose, where a
   // nearly flat ring could fit well in a wrong pose. It is rejected for its coverage, and
   // after lost_after rejections in a row the track is dropped and the next cloud recaptures.
-  std::vector<Points> far = s.clouds(pose(Vec3(0, 0, 20), Vec3(0.3, -0.05, 0.75)), o.lost_after, 4);
+  std::vector<Points> far = s.clouds(make_rigid(Vec3(0, 0, 20), Vec3(0.3, -0.05, 0.75)), o.lost_after, 4);
   for (int i = 0; i < o.lost_after; ++i) {
     EXPECT_TRUE(tracker.pose().has_value());
     const TrackingResult lost = tracker.process(far[i], s.camera_to_world);

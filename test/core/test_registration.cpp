@@ -19,6 +19,7 @@
 
 using namespace btr;
 using btr::test::expect_throw_with;
+using btr::test::make_rigid;
 
 namespace {
 
@@ -79,13 +80,6 @@ double worst_error(const RegistrationResult& r) {
   return w;
 }
 
-Rigid make_rigid(const Vec3& rot_deg, const Vec3& trans) {
-  Rigid T = Rigid::Identity();
-  T.linear() = (Eigen::AngleAxisd(rot_deg.z() * M_PI / 180, Vec3::UnitZ()) * Eigen::AngleAxisd(rot_deg.y() * M_PI / 180, Vec3::UnitY()) *
-                Eigen::AngleAxisd(rot_deg.x() * M_PI / 180, Vec3::UnitX())).toRotationMatrix();
-  T.translation() = trans;
-  return T;
-}
 
 }  // namespace
 

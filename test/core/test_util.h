@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include "breast_tumour_registration/core/types.h"
+#include "breast_tumour_registration/core/rigid_transform.h"
 
 namespace btr::test {
 
@@ -34,6 +34,9 @@ void expect_throw_with(F&& f, const std::string& needle) {
     EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message was: " << e.what();
   }
 }
+
+/// Rigid transform from rotations about x, y, z [deg] (applied in that order) and a translation [m].
+inline Rigid make_rigid(const Vec3& rot_deg, const Vec3& trans) { return rigid_from_rpy(trans, rot_deg * M_PI / 180); }
 
 inline Mat3 random_matrix(std::mt19937& rng, double scale = 1.0) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);

@@ -14,7 +14,7 @@
 #include <limits>
 
 #include "breast_tumour_registration/Register.h"
-#include "breast_tumour_registration/core/types.h"
+#include "breast_tumour_registration/core/rigid_transform.h"
 #include "breast_tumour_registration/ros/converters.h"
 
 namespace {
@@ -138,9 +138,8 @@ TEST(RegistrationNode, ReplayedBagGivesTheTumourWithinThreeMillimetresThePoseWit
   const auto tf = buffer.lookupTransform("world", "breast_model", ros::Time(0));
   const auto& q = tf.transform.rotation;
   const Eigen::Quaterniond tracked(q.w, q.x, q.y, q.z);
-  const Eigen::Quaterniond truth_q = Eigen::AngleAxisd(pose[5] * M_PI / 180, Eigen::Vector3d::UnitZ()) *
-                                     Eigen::AngleAxisd(pose[4] * M_PI / 180, Eigen::Vector3d::UnitY()) *
-                                     Eigen::AngleAxisd(pose[3] * M_PI / 180, Eigen::Vector3d::UnitX());
+  const Eigen::Quaterniond truth_q(
+      btr::rigid_from_rpy(Eigen::Vector3d::Zero(), Eigen::Vector3d(pose[3], pose[4], pose[5]) * M_PI / 180).linear());
   const double rot_deg = tracked.angularDistance(truth_q) * 180 / M_PI;
   const double trans = std::hypot(tf.transform.translation.x - pose[0], tf.transform.translation.y - pose[1],
                                   tf.transform.translation.z - pose[2]);

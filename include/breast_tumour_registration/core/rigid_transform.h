@@ -21,4 +21,11 @@ SurfaceMesh transform_surface(const Rigid& T, const SurfaceMesh& s);
 /// Rotation angle of T [rad] and translation length [m].
 double rotation_angle(const Rigid& T);
 
+/// The transform with this translation [m] and rotation R = Rz(yaw) Ry(pitch) Rx(roll)
+/// (roll_pitch_yaw [rad], fixed axes X then Y then Z; ROS's RPY convention).
+Rigid rigid_from_rpy(const Vec3& translation, const Vec3& roll_pitch_yaw);
+
+/// Largest distance between A p and B p over the rows p of P [m]; 0 for no rows.
+double max_displacement(const Rigid& A, const Rigid& B, const Points& P);
+
 }  // namespace btr
