@@ -68,13 +68,25 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
 
 RegistrationNode::RegistrationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
     : nh_(nh), pnh_(pnh), tf_listener_(tf_buffer_) {
-  params_ = read_node_parameters(pnh_);
+  bool parameters_ok = true;
+  try {
+    params_ = read_node_parameters(pnh_);
+  } catch (const InputError& e) {
+    // Keep running with nothing loaded: the service and ~status say what to fix.
+    parameters_ok = false;
+    scene_error_ = std::string("invalid parameter: ") + e.what();
+  }
   status_pub_ = pnh_.advertise<diagnostic_msgs::DiagnosticStatus>("status", 1, true);
   mesh_pub_ = pnh_.advertise<shape_msgs::Mesh>("tumour_mesh", 1, true);
   marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("tumour_marker", 10, true);
   breast_marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("breast_marker", 1, true);
   result_pub_ = pnh_.advertise<breast_tumour_registration::RegistrationResult>("result", 1, true);
-  load_scene();
+  if (parameters_ok) {
+    load_scene();
+  } else {
+    ROS_ERROR_STREAM(scene_error_ << " (the node keeps running; fix the parameter and restart)");
+    publish_status(diagnostic_msgs::DiagnosticStatus::ERROR, scene_error_);
+  }
   cloud_sub_ = nh_.subscribe("points", 2, &RegistrationNode::on_cloud, this);
   // The service has its own queue and two threads: a registration never blocks the cloud
   // callback, and a second request is answered while the first one runs.
@@ -247,7 +259,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     return true;
   }
   try {
-    if (!loaded_) throw InputError("the scene failed to load: " + scene_error_ + "; fix ~scene and restart the node");
+    if (!loaded_) throw InputError("the node is not ready: " + scene_error_ + "; fix it and restart the node");
     const std::string preset = req.preset.empty() ? params_.preset : req.preset;
     RegistrationOptions opt = preset_options(preset);
     const std::shared_ptr<const Simulation> sim = simulation_for(opt);

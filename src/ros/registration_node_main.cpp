@@ -2,7 +2,6 @@
 #include <malloc.h>
 #include <ros/ros.h>
 
-#include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/ros/registration_node.h"
 
 int main(int argc, char** argv) {
@@ -14,12 +13,7 @@ int main(int argc, char** argv) {
   mallopt(M_TRIM_THRESHOLD, 512 * 1024 * 1024);
   ros::init(argc, argv, "registration_node");
   ros::NodeHandle nh, pnh("~");
-  try {
-    btr::RegistrationNode node(nh, pnh);
-    ros::spin();  // clouds on the global queue; the service spins on its own threads
-  } catch (const btr::InputError& e) {
-    ROS_FATAL("invalid parameter: %s", e.what());
-    return 2;
-  }
+  btr::RegistrationNode node(nh, pnh);  // bad parameters or scene: logged, the node keeps running
+  ros::spin();  // clouds on the global queue; the service spins on its own threads
   return 0;
 }

@@ -155,6 +155,20 @@ TEST(RegistrationNode, ReplayedBagGivesTheTumourWithinThreeMillimetresThePoseWit
   EXPECT_LT(trans, 0.5e-3);
 }
 
+// Run by bad_parameter.test only (node.test filters it out): a node started with a
+// parameter out of range keeps running and answers with the parameter's name.
+TEST(RegistrationNodeBadParameter, KeepsRunningAndNamesTheParameter) {
+  ASSERT_TRUE(ros::service::waitForService(kService, ros::Duration(60)));
+  for (int i = 0; i < 2; ++i) {
+    const auto srv = call(false);
+    EXPECT_FALSE(srv.response.success);
+    EXPECT_NE(srv.response.message.find("invalid parameter"), std::string::npos) << srv.response.message;
+    EXPECT_NE(srv.response.message.find("~smoothing_clouds"), std::string::npos) << srv.response.message;
+    pubs().cloud.publish(sensor_msgs::PointCloud2());  // an empty cloud in between: still alive
+    ros::WallDuration(0.2).sleep();
+  }
+}
+
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   ros::init(argc, argv, "btr_node_rostest");
