@@ -8,12 +8,13 @@
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/point_constraint_energy.h"
+#include "breast_tumour_registration/core/rigid_free_landmark_energy.h"
 #include "breast_tumour_registration/core/subspace_solver.h"
 
 namespace btr {
 
 StepReport landmark_step(const RegistrationModel& model, const std::vector<Anchor>& anchors, const Points& targets,
-                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback) {
+                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback, Rigid* pose) {
   const auto t0 = std::chrono::steady_clock::now();
   if (anchors.empty()) throw InputError("landmark step: no landmarks");
   if (static_cast<Eigen::Index>(anchors.size()) != targets.rows())
@@ -27,7 +28,7 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
   std::vector<int> seeds;
   std::vector<std::vector<int>> cliques;
   for (size_t i = 0; i < anchors.size(); ++i) {
-    springs->add(anchors[i], targets.row(i).transpose());
+    if (!pose) springs->add(anchors[i], targets.row(i).transpose());
     // Seed the sampling with the anchor's dominant vertex (thesis: landmarks first).
     int best = 0;
     for (int k = 1; k < anchors[i].count; ++k)
@@ -35,15 +36,23 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
     if (!model.fixed[anchors[i].v[best]]) seeds.push_back(anchors[i].v[best]);
     cliques.emplace_back(anchors[i].v, anchors[i].v + anchors[i].count);
   }
-  energy.add(springs);
+  std::shared_ptr<RigidFreeLandmarkEnergy> free_springs;
+  if (pose) {
+    free_springs = std::make_shared<RigidFreeLandmarkEnergy>(opt.weight, anchors, targets);
+    energy.add(free_springs);
+    cliques = {free_springs->clique()};
+  } else {
+    energy.add(springs);
+  }
   const SkinningSubspace S = build_skinning_subspace(model.rest.V, model.volume, seeds, model.fixed, opt.subspace);
   HessianAssembler H(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed, cliques);
   NewtonOptions nopt = opt.newton;
   if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
   if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("landmark", it); };
   const NewtonResult r = solve_subspace_newton(energy, H, S.basis, model.rest.T, x, nopt);
+  if (pose) *pose = free_springs->pose(x);
   StepReport rep;
-  rep.name = "landmark";
+  rep.name = pose ? "landmark (pose free)" : "landmark";
   rep.converged = r.converged;
   rep.stop_reason = to_string(r.reason);
   rep.iterations = r.iterations;

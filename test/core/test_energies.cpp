@@ -8,6 +8,7 @@
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/plane_constraint_energy.h"
 #include "breast_tumour_registration/core/point_constraint_energy.h"
+#include "breast_tumour_registration/core/rigid_free_landmark_energy.h"
 #include "breast_tumour_registration/core/total_energy.h"
 #include "test_util.h"
 
@@ -35,11 +36,12 @@ Anchor triangle_anchor(int a, int b, int c) {
 
 // Checks a term's gradient (against central differences of the value) and Hessian
 // (against central differences of the gradient, column by column) at x, with shrinking steps.
-void check_term(const EnergyTerm& term, const TetMesh& mesh, const Points& x) {
+void check_term(const EnergyTerm& term, const TetMesh& mesh, const Points& x,
+                const std::vector<std::vector<int>>& cliques = {}) {
   const int nv = static_cast<int>(x.rows());
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
   term.add_gradient(x, g);
-  HessianAssembler H(nv, mesh.T, {});
+  HessianAssembler H(nv, mesh.T, {}, cliques);
   term.add_hessian(x, false, H);
   const Eigen::MatrixXd Hd = Eigen::MatrixXd(H.matrix());
   ASSERT_LT((Hd - Hd.transpose()).norm(), 1e-9 * std::max(1.0, Hd.norm())) << term.name() << ": Hessian not symmetric";
@@ -141,6 +143,44 @@ TEST(PlaneConstraintEnergy, VertexAndTriangleAnchors) {
   e.add(Anchor::vertex(3), Vec3(0.01, 0.02, 0.03), Vec3(1, 2, 2));
   e.add(triangle_anchor(m.T(2, 0), m.T(2, 1), m.T(2, 3)), Vec3(0.0, 0.01, 0.0), Vec3(0, 0, 3));
   check_term(e, m, perturbed(m, 0.004, 6));
+}
+
+// The pose-free landmark term: exact derivatives (pose eliminated), with data that is a
+// rotated, shifted and noisy copy of the anchors, so the residual is not zero.
+TEST(RigidFreeLandmarkEnergy, GradientAndHessianMatchFiniteDifferences) {
+  const TetMesh m = small_mesh();
+  std::vector<Anchor> anchors = {Anchor::vertex(5), triangle_anchor(m.T(4, 0), m.T(4, 1), m.T(4, 2)), Anchor::vertex(17),
+                                 Anchor::vertex(30), Anchor::vertex(2)};
+  const Points x = perturbed(m, 0.004, 8);
+  Points data(anchors.size(), 3);
+  const Rigid T = btr::test::make_rigid(Vec3(20, -10, 30), Vec3(0.01, -0.02, 0.03));
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.003);
+  for (size_t i = 0; i < anchors.size(); ++i)
+    data.row(i) = (T * anchors[i].position(x) + Vec3(noise(rng), noise(rng), noise(rng))).transpose();
+  const RigidFreeLandmarkEnergy e(1e4, anchors, data);
+  check_term(e, m, x, {e.clique()});
+}
+
+TEST(RigidFreeLandmarkEnergy, PoseIsEliminatedAndProjectedHessianIsPsd) {
+  const TetMesh m = small_mesh();
+  std::vector<Anchor> anchors = {Anchor::vertex(5), Anchor::vertex(11), Anchor::vertex(17), Anchor::vertex(30)};
+  Points data(anchors.size(), 3);
+  const Rigid T = btr::test::make_rigid(Vec3(40, 15, -60), Vec3(0.1, 0.2, -0.3));
+  for (size_t i = 0; i < anchors.size(); ++i) data.row(i) = (T * anchors[i].position(m.V)).transpose();
+  const RigidFreeLandmarkEnergy e(1e4, anchors, data);
+  EXPECT_LT(e.value(m.V), 1e-20);  // any rigid motion of the data costs nothing
+  EXPECT_LT((e.pose(m.V).matrix() - T.inverse().matrix()).norm(), 1e-9);
+  HessianAssembler H(static_cast<int>(m.V.rows()), m.T, {}, {e.clique()});
+  e.add_hessian(perturbed(m, 0.004, 9), true, H);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es{Eigen::MatrixXd(H.matrix())};
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-8 * es.eigenvalues().maxCoeff());
+  // Rigid motions of the anchors are in its null space: 4 landmarks leave 12 - 6 = 6 modes.
+  int nonzero = 0;
+  for (int k = 0; k < es.eigenvalues().size(); ++k) nonzero += es.eigenvalues()[k] > 1e-8 * es.eigenvalues().maxCoeff();
+  EXPECT_EQ(nonzero, 6);
+  btr::test::expect_throw_with<InputError>([&] { RigidFreeLandmarkEnergy(1, {anchors[0], anchors[1]}, data.topRows(2)); },
+                                           "at least 3");
 }
 
 TEST(Constraints, BadWeightsAndNormalsAreRejected) {

@@ -7,6 +7,7 @@
 
 #include "breast_tumour_registration/core/energy_term.h"
 #include "breast_tumour_registration/core/registration_model.h"
+#include "breast_tumour_registration/core/rigid_transform.h"
 #include "breast_tumour_registration/core/skinning_subspace.h"
 
 namespace btr {
@@ -20,7 +21,11 @@ struct LandmarkStepOptions {
 
 /// anchors: prone landmark points on the model; targets: supine landmark positions in the
 /// model frame (rows). x: current positions, updated in place.
+/// pose == nullptr: the targets stay where they are. Otherwise the targets may move rigidly
+/// and their pose is solved jointly with the deformation (RigidFreeLandmarkEnergy; needs
+/// >= 3 landmarks); on return *pose maps the given targets to where they ended.
 StepReport landmark_step(const RegistrationModel& model, const std::vector<Anchor>& anchors, const Points& targets,
-                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback = {});
+                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback = {},
+                         Rigid* pose = nullptr);
 
 }  // namespace btr

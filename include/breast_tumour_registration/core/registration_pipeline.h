@@ -26,6 +26,9 @@ struct RegistrationOptions {
   /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
   /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
   std::optional<Rigid> known_supine_to_model;
+  /// [m] When ICP on the rigid regions decides the pose and the pose solved jointly with the
+  /// landmarks moves the rigid region by more than this, the result carries a warning.
+  double pose_disagreement_warning = 0.003;
 };
 
 /// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
@@ -33,7 +36,7 @@ struct RegistrationOptions {
 RegistrationOptions preset_options(const std::string& name);
 
 struct PlannedSteps {
-  bool rigid_landmarks = false;  ///< Kabsch on >= 3 landmark pairs
+  bool rigid_landmarks = false;  ///< Kabsch on >= 3 landmark pairs (first guess; the landmark step then solves the pose)
   bool rigid_icp = false;        ///< ICP on prone and supine rigid regions
   bool gravity = false;
   bool landmarks = false;
@@ -77,6 +80,8 @@ struct RegistrationResult {
   Rigid supine_to_model = Rigid::Identity();  ///< the rigid alignment found
   bool icp_used = false;
   IcpResult icp;
+  bool pose_solved_with_landmarks = false;  ///< the landmark step solved the pose (no decisive ICP)
+  double pose_disagreement = 0;  ///< [m] ICP vs joint landmark pose, max over the rigid region (when both ran)
   double rigid_seconds = 0;
   std::vector<StepReport> reports;
   Points x;                 ///< deformed vertex positions, model frame
