@@ -21,7 +21,8 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 std::string to_string(StopReason r) {
   switch (r) {
     case StopReason::GradientTolerance: return "gradient tolerance reached";
-    case StopReason::StepTolerance: return "step tolerance reached";
+    case StopReason::StepTolerance: return "full Newton step below the step tolerance";
+    case StopReason::Stalled: return "stalled: line-search steps below the step tolerance with the gradient above its tolerance";
     case StopReason::MaxIterations: return "maximum iterations reached";
     case StopReason::LineSearchFailed: return "line search found no decrease";
     case StopReason::Aborted: return "aborted by callback";
@@ -33,11 +34,7 @@ StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets,
                               const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
                               long& n_inv, IterationInfo& info, NewtonResult& res) {
   const double full_step = dx.rowwise().norm().maxCoeff();
-  if (full_step <= opt.step_tolerance) {
-    res.reason = StopReason::StepTolerance;
-    res.converged = true;
-    return StepOutcome::TooSmall;
-  }
+  if (full_step <= opt.step_tolerance) return StepOutcome::TooSmall;
   const auto t0 = Clock::now();
   const LineSearchResult ls = backtracking_line_search(energy, x, dx, E, slope, n_inv, tets, line_search_options(opt), x_trial);
   info.t_line_search = since(t0);
@@ -45,10 +42,7 @@ StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets,
   res.t_factorization += info.t_factorization;
   res.t_solve += info.t_solve;
   res.t_line_search += info.t_line_search;
-  if (!ls.accepted) {
-    res.reason = StopReason::LineSearchFailed;
-    return StepOutcome::NoDecrease;
-  }
+  if (!ls.accepted) return StepOutcome::NoDecrease;
   x.swap(x_trial);
   E = ls.energy;
   n_inv = ls.inverted;
@@ -69,10 +63,28 @@ bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, doubl
     res.reason = StopReason::Aborted;
     return true;
   }
-  if (info.gradient_norm <= gradient_tolerance || info.step_norm <= opt.step_tolerance) {
-    res.reason = info.gradient_norm <= gradient_tolerance ? StopReason::GradientTolerance : StopReason::StepTolerance;
+  if (info.gradient_norm <= gradient_tolerance) {
+    res.reason = StopReason::GradientTolerance;
     res.converged = true;
     return true;
+  }
+  return false;
+}
+
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonResult& res) {
+  if (direction_was_lagged) return true;  // a fresh factorization first
+  switch (outcome) {
+    case StepOutcome::TooSmall:  // the exact Newton step: the minimum is within step_tolerance
+      res.reason = StopReason::StepTolerance;
+      res.converged = true;
+      break;
+    case StepOutcome::NoDecrease:
+      res.reason = StopReason::LineSearchFailed;
+      res.converged = false;
+      break;
+    default:  // a damped step too short to make progress
+      res.reason = StopReason::Stalled;
+      res.converged = false;
   }
   return false;
 }
@@ -121,6 +133,7 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
   }
 
   Points x_trial(x.rows(), 3);
+  bool fresh_factor = false;  // the last direction stalled on the lagged factor: refactorize
   for (int it = 1; it <= opt.max_iterations; ++it) {
     IterationInfo info;
     info.iteration = it;
@@ -132,7 +145,7 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     auto& llt = impl_->llt;
     Eigen::VectorXd d;
     bool solved = false;
-    if (opt.reuse_factorization && impl_->have_factor) {
+    if (opt.reuse_factorization && impl_->have_factor && !fresh_factor) {
       t0 = Clock::now();
       const double eta = std::min(opt.max_forcing, std::sqrt(g.norm() / std::max(res.initial_gradient_norm, 1e-300)));
       const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
@@ -178,11 +191,21 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
     H.scatter_add(d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
-    if (apply_newton_step(energy, tets_, opt, dx, g.dot(d), x, x_trial, E, n_inv, info, res) != StepOutcome::Taken) break;
+    const StepOutcome outcome = apply_newton_step(energy, tets_, opt, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
+    if (outcome != StepOutcome::Taken) {
+      if (!recover_from_stall(outcome, !info.factorized, res)) break;
+      fresh_factor = true;
+      continue;
+    }
+    fresh_factor = false;
     g = H.gather(energy.gradient(x));
     info.gradient_norm = g.norm();
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
+    if (info.step_norm <= opt.step_tolerance) {  // accepted, but too short to make progress
+      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, res)) break;
+      fresh_factor = true;
+    }
   }
   res.energy = E;
   res.gradient_norm = g.norm();

@@ -25,29 +25,30 @@ bool requested(const Scene& s, const char* step) {
 RegistrationOptions preset_options(const std::string& name) {
   RegistrationOptions o;
   o.preset = name;
-  // Chosen from the measured Pareto front (BENCHMARKS.md, bench/run_tradeoff_benchmarks.sh):
-  // on the 35k-tet phantom the accuracy saturates from a 7 mm simulation mesh on, and more
-  // projections than about 10 only move the surface step towards its fixed point's bias.
+  // A preset is a set of tolerances (what "converged" means for it) and a simulation mesh;
+  // the iteration caps are generous safety limits, reported as not converged when hit.
+  // Mesh sizes from the measured Pareto front (BENCHMARKS.md): on the phantom the accuracy
+  // saturates from a 7 mm simulation mesh on.
+  o.landmark.newton.max_iterations = 60;
+  o.surface.max_projections = 60;
+  o.surface.newton_per_projection = 1;
+  o.surface.newton.max_iterations = 30;
   if (name == "fast") {
     o.simulation_cell_size = 0.009;
     o.landmark.subspace.handles = 30;
-    o.landmark.newton.max_iterations = 4;
     o.landmark.newton.gradient_rel_tolerance = 1e-3;
-    o.surface.max_projections = 5;
-    o.surface.newton_per_projection = 1;
+    o.surface.newton.gradient_rel_tolerance = 1e-3;
+    o.surface.projection_tolerance = 2e-4;
   } else if (name == "balanced") {
     o.simulation_cell_size = 0.007;
     o.landmark.subspace.handles = 60;
-    o.landmark.newton.max_iterations = 10;
     o.landmark.newton.gradient_rel_tolerance = 1e-4;
-    o.surface.max_projections = 4;
-    o.surface.newton_per_projection = 1;
+    o.surface.newton.gradient_rel_tolerance = 1e-4;
+    o.surface.projection_tolerance = 1e-4;
   } else if (name == "accurate") {  // the scene's own mesh
     o.landmark.subspace.handles = 60;
-    o.landmark.newton.max_iterations = 30;
     o.landmark.newton.gradient_rel_tolerance = 1e-6;
-    o.surface.max_projections = 10;
-    o.surface.newton_per_projection = 1;
+    o.surface.newton.gradient_rel_tolerance = 1e-6;
     o.surface.projection_tolerance = 1e-5;
   } else {
     throw InputError("unknown preset '" + name + "' (fast, balanced, accurate)");
@@ -130,7 +131,10 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   r.steps = plan_steps(scene);
   r.x = model.rest.V;
 
-  // 1. Rigid alignment: Kabsch on the landmarks, then ICP on the rigid regions.
+  // 1. Rigid alignment. Kabsch on the landmarks is only a first guess: the landmarks sit on
+  // deforming skin, so their fit absorbs part of the breast's own sag. Where the landmark step
+  // runs, it solves the pose jointly with the deformation (gravity explains the sag); where
+  // rigid regions are given, ICP on them has the final word.
   auto t0 = Clock::now();
   Rigid T = Rigid::Identity();
   if (opt.known_supine_to_model) {
@@ -143,11 +147,10 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       prone_lm.row(i) = scene.landmark_anchors[i].position(model.rest.V).transpose();
     T = kabsch(scene.landmark_supine, prone_lm);
   }
+  const bool joint_pose = r.steps.rigid_landmarks && r.steps.landmarks;
   if (r.steps.rigid_icp) {
-    // The rigid regions decide: landmarks sit on deforming skin, so their Kabsch fit absorbs
-    // part of the breast's own motion (tens of millimetres for soft tissue). ICP starts from
-    // the landmark fit, the identity and the centroid-matched regions; the accepted result
-    // with the lowest inlier RMS wins.
+    // ICP starts from the landmark fit, the identity and the centroid-matched regions; the
+    // accepted result with the lowest inlier RMS wins.
     std::vector<Rigid> starts = {T};
     if (r.steps.rigid_landmarks) starts.push_back(Rigid::Identity());
     Rigid centred = Rigid::Identity();
@@ -166,20 +169,14 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       r.icp_used = true;
     } else {
       r.warnings.push_back("rigid alignment: " + r.icp.message + " from every initial guess; keeping the " +
-                           (r.steps.rigid_landmarks ? "landmark" : "identity") + " alignment");
+                           (r.steps.rigid_landmarks ? (joint_pose ? "pose solved with the landmarks" : "landmark alignment")
+                                                    : "identity alignment"));
     }
-  } else if (r.steps.rigid_landmarks) {
-    r.warnings.push_back("rigid alignment from landmarks only: landmarks on deforming skin bias it; give the rigid "
-                         "regions (chest_ring and supine.chest_ring) for ICP");
+  } else if (r.steps.rigid_landmarks && !joint_pose) {
+    r.warnings.push_back("rigid alignment from landmarks only (Kabsch): landmarks on deforming skin bias it; add the "
+                         "landmark step, or give the rigid regions (chest_ring and supine.chest_ring) for ICP");
   }
-  r.supine_to_model = T;
   r.rigid_seconds = since(t0);
-  Points targets = scene.landmark_supine.rows() ? transform_points(T, scene.landmark_supine) : Points();
-  // The supine surface in the model frame, as a projector (AABB tree or kd-tree + normals),
-  // built once for the surface step and the skin-distance figure.
-  std::unique_ptr<SurfaceProjector> supine;
-  if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface));
-  else if (scene.supine_cloud) supine = make_cloud_projector(transform_points(T, *scene.supine_cloud));
 
   // 2. Optional gravity pre-step (thesis Sec. 5.2.2: gravity + surface).
   if (r.steps.gravity) {
@@ -205,8 +202,38 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     rep.add_newton_profile(nr);
     r.reports.push_back(rep);
   }
-  // 3. Landmark-guided step.
-  if (r.steps.landmarks) r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback));
+  // 3. Landmark-guided step; without a decisive rigid region, with the pose as unknowns.
+  Points targets = scene.landmark_supine.rows() ? transform_points(T, scene.landmark_supine) : Points();
+  if (r.steps.landmarks) {
+    if (joint_pose && !r.icp_used) {
+      Rigid moved = Rigid::Identity();
+      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback, &moved));
+      T = moved * T;
+      targets = transform_points(moved, targets);
+      r.pose_solved_with_landmarks = true;
+    } else {
+      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback));
+      if (joint_pose) {
+        // ICP decided the pose; the joint fit (warm-started from this result) checks it.
+        Points xj = r.x;
+        Rigid moved = Rigid::Identity();
+        const StepReport check = landmark_step(model, scene.landmark_anchors, targets, opt.landmark, xj, {}, &moved);
+        r.pose_disagreement = max_displacement(moved, Rigid::Identity(), scene.prone_rigid->V);
+        if (r.pose_disagreement > opt.pose_disagreement_warning)
+          r.warnings.push_back("rigid alignment: ICP on the rigid regions and the pose solved with the landmarks differ by " +
+                               std::to_string(r.pose_disagreement * 1e3) + " mm on the rigid region (" +
+                               (check.converged ? "" : "joint fit not converged; ") +
+                               "ICP kept): check the landmark pairs and the rigid regions");
+      }
+    }
+  }
+  r.supine_to_model = T;
+  // The supine surface in the model frame, as a projector (AABB tree or kd-tree + normals),
+  // built once for the surface step and the skin-distance figure.
+  std::unique_ptr<SurfaceProjector> supine;
+  if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface));
+  else if (scene.supine_cloud) supine = make_cloud_projector(transform_points(T, *scene.supine_cloud));
+
   // 4. Surface-guided step.
   if (r.steps.surface) r.reports.push_back(surface_step(model, *supine, opt.surface, r.x, callback));
   for (const auto& rep : r.reports) r.converged = r.converged && rep.converged;

@@ -48,6 +48,7 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
   Points x_trial(x.rows(), 3);
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   bool have_factor = false;
+  bool fresh_factor = false;  // the last direction stalled on the lagged factor: refactorize
   for (int it = 1; it <= opt.max_iterations; ++it) {
     IterationInfo info;
     info.iteration = it;
@@ -59,7 +60,7 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     // PCG does not reach the forcing tolerance.
     Eigen::VectorXd d;
     bool solved = false;
-    if (opt.reuse_factorization && have_factor) {
+    if (opt.reuse_factorization && have_factor && !fresh_factor) {
       t0 = Clock::now();
       const double eta = std::min(opt.max_forcing, std::sqrt(gr.norm() / std::max(res.initial_gradient_norm, 1e-300)));
       const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
@@ -101,11 +102,21 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     H.scatter_add(U * d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
     info.t_solve += since(t0);
-    if (apply_newton_step(energy, tets, opt, dx, gr.dot(d), x, x_trial, E, n_inv, info, res) != StepOutcome::Taken) break;
+    const StepOutcome outcome = apply_newton_step(energy, tets, opt, dx, gr.dot(d), x, x_trial, E, n_inv, info, res);
+    if (outcome != StepOutcome::Taken) {
+      if (!recover_from_stall(outcome, !info.factorized, res)) break;
+      fresh_factor = true;
+      continue;
+    }
+    fresh_factor = false;
     gr = Ut * H.gather(energy.gradient(x));
     info.gradient_norm = gr.norm();
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
+    if (info.step_norm <= opt.step_tolerance) {  // accepted, but too short to make progress
+      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, res)) break;
+      fresh_factor = true;
+    }
   }
   res.energy = E;
   res.gradient_norm = gr.norm();

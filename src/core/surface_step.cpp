@@ -73,6 +73,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       shifted.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       return callback("surface", shifted);
     };
+    // Once the projections have settled, Newton runs to its gradient criterion on them:
+    // converged means both held, not that a budget ran out.
+    const bool settled = outer > 1 && moved_rms <= opt.projection_tolerance;
+    nopt.max_iterations = settled ? std::max(opt.newton_per_projection, opt.newton.max_iterations) : opt.newton_per_projection;
     const NewtonResult r = solver.solve(energy, x, nopt);
     offset += r.iterations;
     rep.add_newton_profile(r);
@@ -82,18 +86,22 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.gradient_norm = r.gradient_norm;
     rep.stop_reason = to_string(r.reason);
     if (r.reason == StopReason::Aborted) break;
-    if (outer > 1 && moved_rms <= opt.projection_tolerance && r.converged) {
-      rep.converged = true;
-      rep.stop_reason = "projections stopped moving";
+    if (r.reason == StopReason::Stalled || r.reason == StopReason::LineSearchFailed) {
+      rep.stop_reason = "Newton " + rep.stop_reason + " (gradient " + std::to_string(r.gradient_norm) + " N)";
+      break;
+    }
+    if (settled) {
+      rep.converged = r.converged;
+      rep.stop_reason = r.converged ? "projections stopped moving and the gradient criterion held"
+                                    : "projections stopped moving but Newton reached its iteration cap";
       break;
     }
   }
-  if (!rep.converged && rep.stop_reason != to_string(StopReason::Aborted)) {
-    rep.converged = rep.projection_rms_change <= opt.budget_tolerance;
-    rep.stop_reason = std::string("projection budget reached, last RMS change ") +
-                      std::to_string(rep.projection_rms_change * 1e3) + " mm" +
-                      (rep.converged ? " (within the budget tolerance)" : " (above the budget tolerance)");
-  }
+  if (!rep.converged && rep.outer_iterations == opt.max_projections && rep.stop_reason.rfind("projections", 0) != 0 &&
+      rep.stop_reason.rfind("Newton", 0) != 0 && rep.stop_reason != to_string(StopReason::Aborted))
+    rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached with the projections still moving " +
+                      std::to_string(rep.projection_rms_change * 1e3) + " mm RMS (tolerance " +
+                      std::to_string(opt.projection_tolerance * 1e3) + " mm)";
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;
 }

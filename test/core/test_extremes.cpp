@@ -34,7 +34,8 @@ void expect_sane(const NewtonResult& r, const Points& x) {
   }
   EXPECT_LE(r.iterations, 100);
   if (!r.converged) {
-    EXPECT_TRUE(r.reason == StopReason::MaxIterations || r.reason == StopReason::LineSearchFailed)
+    EXPECT_TRUE(r.reason == StopReason::MaxIterations || r.reason == StopReason::LineSearchFailed ||
+                r.reason == StopReason::Stalled)
         << to_string(r.reason);
   }
 }
@@ -59,9 +60,14 @@ TEST_P(MaterialExtremes, GravitySolveStaysFiniteAndMonotone) {
   const NewtonResult r = solver.solve(energy, x, opt);
   expect_sane(r, x);
   EXPECT_EQ(count_inverted(x, s.mesh.T), 0);
-  // Realistic tissue converges; the extremes are allowed to stop on the iteration cap.
-  if (c.E >= 200) {
+  // Realistic tissue converges; the extremes may stop on the cap or stall, and say so. At
+  // E = 200 Pa pressed onto its chest wall the mini breast stalls on a nearly flat element
+  // (measured: gradient 0.29 N of a 3.8 N weight), which used to be reported as converged.
+  if (c.E >= 400) {
     EXPECT_TRUE(r.converged) << to_string(r.reason);
+  }
+  if (r.reason == StopReason::GradientTolerance) {
+    EXPECT_LE(r.gradient_norm, opt.gradient_rel_tolerance * std::max(r.initial_gradient_norm, 0.0) + opt.gradient_abs_tolerance);
   }
 }
 

@@ -115,3 +115,20 @@ TEST(NewtonSolver, NonFiniteStartIsAClearError) {
   x(3, 1) = std::numeric_limits<double>::quiet_NaN();
   btr::test::expect_throw_with<SolverError>([&] { solver.solve(energy, x, NewtonOptions{}); }, "not finite");
 }
+
+// A stall is never convergence: a lagged direction is retried on a fresh factor, an exact
+// Newton step below the step tolerance is convergence, a damped one is a stall.
+TEST(NewtonSolver, StallsAreRetriedThenReportedAsStalls) {
+  NewtonResult r;
+  EXPECT_TRUE(recover_from_stall(StepOutcome::Stalled, true, r));
+  EXPECT_TRUE(recover_from_stall(StepOutcome::NoDecrease, true, r));
+  EXPECT_FALSE(recover_from_stall(StepOutcome::Stalled, false, r));
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.reason, StopReason::Stalled);
+  EXPECT_FALSE(recover_from_stall(StepOutcome::NoDecrease, false, r));
+  EXPECT_FALSE(r.converged);
+  EXPECT_EQ(r.reason, StopReason::LineSearchFailed);
+  EXPECT_FALSE(recover_from_stall(StepOutcome::TooSmall, false, r));
+  EXPECT_TRUE(r.converged);
+  EXPECT_EQ(r.reason, StopReason::StepTolerance);
+}

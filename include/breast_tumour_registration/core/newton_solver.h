@@ -15,9 +15,11 @@ namespace btr {
 
 enum class StopReason {
   GradientTolerance,  ///< |g| <= abs_tol + rel_tol max(|g0|, force_scale)   (converged)
-  StepTolerance,      ///< max vertex displacement of a full step below step_tolerance (converged)
-  MaxIterations,      ///< iteration cap reached
-  LineSearchFailed,   ///< no step decreased the energy; state is the best found
+  StepTolerance,      ///< the full Newton step of a fresh factorization is below step_tolerance (converged:
+                      ///< the minimum of the Newton model is that close; the gradient is at round-off)
+  Stalled,            ///< damped line-search steps below step_tolerance while the full step is not (not converged)
+  MaxIterations,      ///< iteration cap reached (not converged)
+  LineSearchFailed,   ///< no step decreased the energy even on a fresh factorization; state is the best found
   Aborted,            ///< the callback asked to stop
 };
 std::string to_string(StopReason r);
@@ -79,10 +81,20 @@ struct NewtonResult {
 
 /// Records an accepted iteration in `res` (history, totals), calls the callback and applies
 /// the stopping rules; returns true when the solve should stop (reason and converged set).
+/// Converged means the gradient criterion held (or, in the caller, a fresh full Newton step
+/// below step_tolerance); a damped step below it is a stall, never convergence.
 bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res);
 
 /// Outcome of trying a Newton direction.
-enum class StepOutcome { Taken, TooSmall, NoDecrease };
+/// TooSmall: the full (undamped) step is below step_tolerance; Stalled: the line search
+/// accepted a step, but one below step_tolerance while the full step is not.
+enum class StepOutcome { Taken, TooSmall, NoDecrease, Stalled };
+
+/// After a direction that did not make progress (TooSmall, NoDecrease, Stalled): true when
+/// the direction came from the lagged factor, so the caller should retry the iteration on a
+/// fresh factorization (what a stall calls for first); otherwise sets the final reason in res
+/// (StepTolerance, converged; LineSearchFailed or Stalled, not converged) and returns false.
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonResult& res);
 
 /// Shared by the full-space and subspace solvers: takes the step dx (#V by 3) with the line
 /// search from x (energy E, n_inv inverted tetrahedra), updating x, E, n_inv, the iteration's

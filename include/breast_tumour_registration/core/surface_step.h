@@ -15,14 +15,14 @@ struct SurfaceStepOptions {
   double point_weight = 30;      ///< [N/m] per skin vertex: allows tangential sliding
   double plane_weight = 3000;    ///< [N/m] per skin vertex: holds the skin on the surface
   bool gravity = true;
-  int max_projections = 30;      ///< outer iterations (projection + Newton)
+  /// Safety cap on the outer iterations (projection + Newton); reaching it is reported as
+  /// not converged, with the last change of the projections.
+  int max_projections = 40;
   int newton_per_projection = 1; ///< Newton iterations between projections (thesis: 1)
-  /// [m] stop when the RMS change of the projections falls below this (the max is reported:
-  /// a few rim vertices keep flipping between the faces of a sharp edge).
+  /// [m] Convergence: the RMS change of the projections falls below this (the max is reported:
+  /// a few rim vertices keep flipping between the faces of a sharp edge), then Newton on the
+  /// settled projections meets its gradient criterion (up to newton.max_iterations).
   double projection_tolerance = 2e-5;
-  /// When the projection budget runs out, the step still counts as converged if the last
-  /// RMS change was below this [m] (a preset that trades accuracy for speed); else it failed.
-  double budget_tolerance = 1e-4;
   /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
   double max_projection_distance = 0.03;
   /// Projections onto the border of an open supine surface (the edge of a depth scan, the
