@@ -12,6 +12,7 @@ DEB_PACKAGES=(
   ros-core-dev libtf2-ros-dev libtf2-eigen-dev libpcl-conversions-dev libpcl-dev
   libcgal-dev libsuitesparse-dev libeigen3-dev python3-rostest librostest-dev
   python3-rosbag librosbag-dev ros-message-generation libstd-srvs-dev python3-roslaunch
+  rosbash python3-rosservice  # rosrun, rosservice: the README's commands
   libsensor-msgs-dev libshape-msgs-dev libvisualization-msgs-dev libgeometry-msgs-dev libdiagnostic-msgs-dev
   libtf2-msgs-dev
   libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
