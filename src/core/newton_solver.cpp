@@ -140,6 +140,7 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
 
     auto t0 = Clock::now();
     energy.hessian(x, opt.project_psd, H);
+    const LowRankHessian low = energy.low_rank_hessian(x, H);  // H - W M W^T (usually empty)
     info.t_assembly = since(t0);
 
     auto& llt = impl_->llt;
@@ -149,7 +150,12 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
       t0 = Clock::now();
       const double eta = std::min(opt.max_forcing, std::sqrt(g.norm() / std::max(res.initial_gradient_norm, 1e-300)));
       const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
-      solved = preconditioned_cg([&](const Eigen::VectorXd& v) { return Eigen::VectorXd(Hs * v); },
+      auto apply = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd out = Hs * v;
+        if (low.W.cols()) out.noalias() -= low.W * (low.M * (low.W.transpose() * v));
+        return out;
+      };
+      solved = preconditioned_cg(apply,
                                  [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(impl_->llt.solve(v)); }, -g, eta,
                                  opt.max_pcg_iterations, d, info.pcg_iterations);
       info.t_solve = since(t0);
@@ -183,6 +189,12 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
       info.t_factorization = since(t0);
       t0 = Clock::now();
       d = -llt.solve(g);
+      if (low.W.cols()) {
+        // Woodbury: (H - W M W^T)^-1 = H^-1 + Z (I - M W^T Z)^-1 M Z^T with Z = H^-1 W.
+        const Eigen::MatrixXd Z = llt.solve(low.W);
+        const Eigen::MatrixXd K = Eigen::MatrixXd::Identity(low.M.rows(), low.M.rows()) - low.M * (low.W.transpose() * Z);
+        d += Z * K.fullPivLu().solve(low.M * (Z.transpose() * -g));
+      }
       info.t_solve += since(t0);
     }
     if (!d.allFinite()) throw SolverError("Newton direction is not finite");

@@ -54,6 +54,8 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     info.iteration = it;
     auto t0 = Clock::now();
     energy.hessian(x, opt.project_psd, H);
+    const LowRankHessian low = energy.low_rank_hessian(x, H);  // H - W M W^T (usually empty)
+    const Eigen::MatrixXd UtW = Ut * low.W;
     info.t_assembly = since(t0);
     // Later iterations: PCG on U^T H U (applied as three sparse products) with the lagged
     // dense factor as preconditioner; the sparse-sparse product U^T H U is formed only when
@@ -64,7 +66,11 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
       t0 = Clock::now();
       const double eta = std::min(opt.max_forcing, std::sqrt(gr.norm() / std::max(res.initial_gradient_norm, 1e-300)));
       const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
-      auto apply = [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(Ut * (Hs * (U * v))); };
+      auto apply = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd out = Ut * (Hs * (U * v));
+        if (UtW.cols()) out.noalias() -= UtW * (low.M * (UtW.transpose() * v));
+        return out;
+      };
       int k = 0;
       solved = preconditioned_cg(apply, [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(ldlt.solve(v)); }, -gr,
                                  eta, opt.max_pcg_iterations, d, k);
@@ -83,6 +89,7 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
         const Eigen::SparseMatrix<double> Ub = U.middleCols(c0, nc);
         Hr.middleCols(c0, nc) = Eigen::MatrixXd(Ut * (H.matrix() * Ub));
       }
+      if (UtW.cols()) Hr.noalias() -= UtW * low.M * UtW.transpose();
       info.t_assembly += since(t0);
       t0 = Clock::now();
       const double shift = 1e-12 * std::max(Hr.diagonal().cwiseAbs().maxCoeff(), 1e-300);

@@ -19,4 +19,21 @@ void TotalEnergy::hessian(const Points& x, bool project_psd, HessianAssembler& H
   for (const auto& t : terms_) t->add_hessian(x, project_psd, H);
 }
 
+LowRankHessian TotalEnergy::low_rank_hessian(const Points& x, const HessianAssembler& H) const {
+  std::vector<LowRankHessian> parts;
+  for (const auto& t : terms_) t->add_low_rank_hessian(x, parts);
+  Eigen::Index k = 0;
+  for (const auto& p : parts) k += p.M.rows();
+  LowRankHessian out;
+  out.W.setZero(H.num_free_dofs(), k);
+  out.M.setZero(k, k);
+  Eigen::Index c = 0;
+  for (const auto& p : parts) {
+    for (Eigen::Index j = 0; j < p.W.cols(); ++j) out.W.col(c + j) = H.gather(p.W.col(j));
+    out.M.block(c, c, p.M.rows(), p.M.cols()) = p.M;
+    c += p.M.rows();
+  }
+  return out;
+}
+
 }  // namespace btr

@@ -4,11 +4,21 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "breast_tumour_registration/core/hessian_pattern.h"
 #include "breast_tumour_registration/core/types.h"
 
 namespace btr {
+
+/// A dense low-rank part subtracted from a term's sparse Hessian: d2E/dx2 = H_sparse - W M W^T.
+/// It arises where a few unknowns coupled to many vertices are eliminated (a rigid pose
+/// solved inside surface springs): the solvers apply it by the Woodbury identity instead of
+/// filling the sparse pattern. W  3#V by k (full DOF layout), M  k by k symmetric PSD.
+struct LowRankHessian {
+  Eigen::MatrixXd W;
+  Eigen::MatrixXd M;
+};
 
 class EnergyTerm {
  public:
@@ -20,6 +30,8 @@ class EnergyTerm {
   virtual void add_gradient(const Points& x, Eigen::VectorXd& g) const = 0;
   /// Adds d2E/dx2 into H; with project_psd, each local block is made PSD first.
   virtual void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const = 0;
+  /// Appends the low-rank part subtracted from add_hessian's matrix; most terms have none.
+  virtual void add_low_rank_hessian(const Points& /*x*/, std::vector<LowRankHessian>& /*parts*/) const {}
 };
 
 /// A point carried by up to four mesh vertices: p(x) = sum_k w_k x_{v_k}

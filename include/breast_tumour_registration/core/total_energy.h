@@ -18,6 +18,9 @@ class TotalEnergy {
   Eigen::VectorXd gradient(const Points& x) const;
   /// Zeroes H and assembles every term into it.
   void hessian(const Points& x, bool project_psd, HessianAssembler& H) const;
+  /// The terms' low-rank parts gathered to the assembler's free DOFs as one W (free DOFs by
+  /// k) and a block-diagonal M; W has no columns when no term has one.
+  LowRankHessian low_rank_hessian(const Points& x, const HessianAssembler& H) const;
 
  private:
   std::vector<std::shared_ptr<const EnergyTerm>> terms_;
