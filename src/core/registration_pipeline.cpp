@@ -227,15 +227,25 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       }
     }
   }
-  r.supine_to_model = T;
-  // The supine surface in the model frame, as a projector (AABB tree or kd-tree + normals),
-  // built once for the surface step and the skin-distance figure.
+  // The supine surface in the model frame as the rigid step left it, as a projector (AABB
+  // tree or kd-tree + normals), built once for the surface step and the skin-distance figure.
   std::unique_ptr<SurfaceProjector> supine;
   if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface));
   else if (scene.supine_cloud) supine = make_cloud_projector(transform_points(T, *scene.supine_cloud));
 
-  // 4. Surface-guided step.
-  if (r.steps.surface) r.reports.push_back(surface_step(model, *supine, opt.surface, r.x, callback));
+  // 4. Surface-guided step; where the pose was estimated without a decisive rigid region, the
+  // whole skin refines it jointly with the deformation.
+  Rigid to_projector = Rigid::Identity();  // model frame -> the projector's frame
+  if (r.steps.surface) {
+    const bool free_pose = (r.steps.rigid_landmarks || r.steps.rigid_icp) && !r.icp_used;
+    PosePoints lm{scene.landmark_anchors, targets};
+    r.reports.push_back(surface_step(model, *supine, opt.surface, r.x, callback, free_pose ? &to_projector : nullptr,
+                                     targets.rows() >= 3 ? &lm : nullptr));
+    r.pose_solved_with_surface = free_pose;
+    T = to_projector.inverse() * T;
+    if (targets.rows()) targets = transform_points(to_projector.inverse(), targets);
+  }
+  r.supine_to_model = T;
   for (const auto& rep : r.reports) r.converged = r.converged && rep.converged;
   r.seconds = since(t_start);
 
@@ -271,7 +281,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   }
   if (supine) {
     std::vector<double> d;
-    for (int v : model.skin) d.push_back(supine->project(r.x.row(v).transpose()).distance);
+    for (int v : model.skin) d.push_back(supine->project(to_projector * Vec3(r.x.row(v).transpose())).distance);
     const DistanceStats st = distance_stats(d);
     r.skin_distance_mean = st.mean;
     r.skin_distance_max = st.max;

@@ -54,6 +54,7 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   j << "], \"translation_mm\": " << vec_mm(r.supine_to_model.translation())
     << ", \"rotation_deg\": " << num(rotation_angle(r.supine_to_model) * 180 / M_PI) << ", \"icp_used\": "
     << (r.icp_used ? "true" : "false") << ", \"pose_solved_with_landmarks\": " << (r.pose_solved_with_landmarks ? "true" : "false")
+    << ", \"pose_solved_with_surface\": " << (r.pose_solved_with_surface ? "true" : "false")
     << ", \"icp_vs_landmark_pose_mm\": " << num(r.pose_disagreement * 1e3) << ", \"icp\": {\"accepted\": " << (r.icp.accepted ? "true" : "false")
     << ", \"converged\": " << (r.icp.converged ? "true" : "false") << ", \"inlier_rms_mm\": " << num(r.icp.inlier_rms * 1e3)
     << ", \"overlap\": " << num(r.icp.overlap) << ", \"iterations\": " << r.icp.iterations

@@ -9,11 +9,12 @@
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/plane_constraint_energy.h"
 #include "breast_tumour_registration/core/point_constraint_energy.h"
+#include "breast_tumour_registration/core/rigid_free_surface_energy.h"
 
 namespace btr {
 
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
-                        Points& x, const StepCallback& callback) {
+                        Points& x, const StepCallback& callback, Rigid* pose, const PosePoints* pose_points) {
   const auto t0 = std::chrono::steady_clock::now();
   if (opt.max_projections < 1 || opt.newton_per_projection < 1)
     throw InputError("surface step: max_projections and newton_per_projection must be >= 1");
@@ -24,8 +25,14 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   if (opt.gravity) energy.add(gravity);
   auto points = std::make_shared<PointConstraintEnergy>(opt.point_weight);
   auto planes = std::make_shared<PlaneConstraintEnergy>(opt.plane_weight);
-  energy.add(points);
-  energy.add(planes);
+  auto free_springs = std::make_shared<RigidFreeSurfaceEnergy>(opt.point_weight, opt.plane_weight);
+  if (pose) {
+    if (pose_points) free_springs->set_points(pose_points->anchors, pose_points->targets, opt.pose_points_weight);
+    energy.add(free_springs);
+  } else {
+    energy.add(points);
+    energy.add(planes);
+  }
   NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed),
                       model.rest.T);
   NewtonOptions nopt = opt.newton;
@@ -33,7 +40,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
 
   StepReport rep;
-  rep.name = "surface";
+  rep.name = pose ? "surface (pose free)" : "surface";
+  Rigid P = Rigid::Identity();  // model frame -> the projector's frame (moves only when pose != nullptr)
+  std::vector<int> held;
+  Points held_y, held_n;
   rep.t_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   Points targets = Points::Zero(static_cast<Eigen::Index>(model.skin.size()), 3);
   int offset = 0;
@@ -41,11 +51,15 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     const auto tp = std::chrono::steady_clock::now();
     points->clear();
     planes->clear();
+    held.clear();
     double moved = 0, moved_sq = 0;
     int kept = 0;
+    if (pose && outer > 1) P = free_springs->pose(x);
+    held_y.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
+    held_n.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
     for (size_t i = 0; i < model.skin.size(); ++i) {
       const int v = model.skin[i];
-      const Projection c = supine.project(x.row(v).transpose());
+      const Projection c = supine.project(P * Vec3(x.row(v).transpose()));
       const double m = (c.point - targets.row(i).transpose()).norm();
       targets.row(i) = c.point.transpose();
       if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) continue;
@@ -54,10 +68,17 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       // scan's border slides along it as the skin moves).
       moved = std::max(moved, m);
       moved_sq += m * m;
-      points->add(Anchor::vertex(v), c.point);
-      planes->add(Anchor::vertex(v), c.point, c.normal);
+      if (pose) {
+        held_y.row(kept) = c.point.transpose();
+        held_n.row(kept) = c.normal.transpose();
+        held.push_back(v);
+      } else {
+        points->add(Anchor::vertex(v), c.point);
+        planes->add(Anchor::vertex(v), c.point, c.normal);
+      }
       ++kept;
     }
+    if (pose) free_springs->set(held, held_y.topRows(kept), held_n.topRows(kept));
     const double moved_rms = kept ? std::sqrt(moved_sq / kept) : 0.0;
     rep.t_projection += std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
     rep.projection_rms_change = moved_rms;
@@ -102,6 +123,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached with the projections still moving " +
                       std::to_string(rep.projection_rms_change * 1e3) + " mm RMS (tolerance " +
                       std::to_string(opt.projection_tolerance * 1e3) + " mm)";
+  if (pose) *pose = free_springs->size() >= 3 ? free_springs->pose(x) : P;
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;
 }

@@ -6,9 +6,11 @@
 #include "breast_tumour_registration/core/elastic_energy.h"
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/gravity_energy.h"
+#include "breast_tumour_registration/core/newton_solver.h"
 #include "breast_tumour_registration/core/plane_constraint_energy.h"
 #include "breast_tumour_registration/core/point_constraint_energy.h"
 #include "breast_tumour_registration/core/rigid_free_landmark_energy.h"
+#include "breast_tumour_registration/core/rigid_free_surface_energy.h"
 #include "breast_tumour_registration/core/total_energy.h"
 #include "test_util.h"
 
@@ -181,6 +183,112 @@ TEST(RigidFreeLandmarkEnergy, PoseIsEliminatedAndProjectedHessianIsPsd) {
   EXPECT_EQ(nonzero, 6);
   btr::test::expect_throw_with<InputError>([&] { RigidFreeLandmarkEnergy(1, {anchors[0], anchors[1]}, data.topRows(2)); },
                                            "at least 3");
+}
+
+namespace {
+// Surface springs on the box's top face (z = 0.04), scan points a rigid motion away.
+RigidFreeSurfaceEnergy surface_springs(const TetMesh& m, const Points& x, const Rigid& P, double noise) {
+  std::vector<int> verts;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    if (m.V(i, 2) > 0.039) verts.push_back(static_cast<int>(i));
+  Points y(verts.size(), 3), n(verts.size(), 3);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> nd(0.0, noise);
+  for (size_t j = 0; j < verts.size(); ++j) {
+    y.row(j) = (P * Vec3(x.row(verts[j]).transpose()) + Vec3(nd(rng), nd(rng), nd(rng))).transpose();
+    n.row(j) = (P.linear() * Vec3(0.1 * static_cast<double>(j % 3), 0.2, 1.0)).transpose();
+  }
+  RigidFreeSurfaceEnergy e(30, 3000);
+  e.set(verts, y, n);
+  return e;
+}
+
+Eigen::MatrixXd dense_hessian(const EnergyTerm& e, const TetMesh& m, const Points& x) {
+  HessianAssembler H(static_cast<int>(x.rows()), m.T, {});
+  H.set_zero();
+  e.add_hessian(x, true, H);
+  std::vector<LowRankHessian> parts;
+  e.add_low_rank_hessian(x, parts);
+  Eigen::MatrixXd D(H.matrix());
+  for (const auto& p : parts) D -= p.W * p.M * p.W.transpose();
+  return D;
+}
+}  // namespace
+
+TEST(RigidFreeSurfaceEnergy, GradientMatchesFiniteDifferencesAwayFromTheScan) {
+  const TetMesh m = small_mesh();
+  const Points x = perturbed(m, 0.003, 12);
+  RigidFreeSurfaceEnergy e = surface_springs(m, m.V, btr::test::make_rigid(Vec3(10, -5, 20), Vec3(0.01, 0, -0.02)), 0.002);
+  Points targets(2, 3);
+  targets << 0.01, 0.02, 0.03, -0.01, 0.0, 0.05;
+  e.set_points({triangle_anchor(m.T(4, 0), m.T(4, 1), m.T(4, 2)), Anchor::vertex(3)}, targets, 1e4);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  e.add_gradient(x, g);
+  double best = 1e300;
+  for (double h = 1e-4; h >= 1e-8; h *= 0.1) {
+    Eigen::VectorXd gn(x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) {
+      Points xp = x, xm = x;
+      xp.data()[i] += h;
+      xm.data()[i] -= h;
+      gn[i] = (e.value(xp) - e.value(xm)) / (2 * h);
+    }
+    best = std::min(best, (gn - g).norm() / g.norm());
+  }
+  EXPECT_LT(best, 1e-6);
+}
+
+TEST(RigidFreeSurfaceEnergy, HessianWithItsLowRankPartMatchesFiniteDifferencesOnTheScan) {
+  const TetMesh m = small_mesh();
+  const Points x = perturbed(m, 0.003, 13);
+  const Rigid P = btr::test::make_rigid(Vec3(-15, 25, 40), Vec3(0.02, 0.01, 0));
+  const RigidFreeSurfaceEnergy e = surface_springs(m, x, P, 0.0);  // zero residual: Gauss-Newton is exact
+  EXPECT_LT(e.value(x), 1e-20);
+  EXPECT_LT((e.pose(x).matrix() - P.matrix()).norm(), 1e-9);
+  const Eigen::MatrixXd Hd = dense_hessian(e, m, x);
+  double best = 1e300;
+  for (double h = 1e-4; h >= 1e-7; h *= 0.1) {
+    Eigen::MatrixXd Hn(x.size(), x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i) {
+      Points xp = x, xm = x;
+      xp.data()[i] += h;
+      xm.data()[i] -= h;
+      Eigen::VectorXd gp = Eigen::VectorXd::Zero(x.size()), gm = Eigen::VectorXd::Zero(x.size());
+      e.add_gradient(xp, gp);
+      e.add_gradient(xm, gm);
+      Hn.col(i) = (gp - gm) / (2 * h);
+    }
+    best = std::min(best, (Hn - Hd).norm() / Hd.norm());
+  }
+  EXPECT_LT(best, 1e-5);
+  // Rigid motions of the constrained vertices cost nothing: PSD with a 6-dimensional null space among them.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Hd);
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-8 * es.eigenvalues().maxCoeff());
+  int zero_on_springs = 0;
+  for (Eigen::Index k = 0; k < es.eigenvalues().size(); ++k) zero_on_springs += es.eigenvalues()[k] < 1e-8 * es.eigenvalues().maxCoeff();
+  EXPECT_EQ(zero_on_springs, static_cast<int>(x.size() - 3 * e.size() + 6));
+}
+
+// The solver applies the low-rank part (Woodbury on the factor, and in PCG): a mesh held only
+// by pose-free springs to a moved copy of its own top face settles back onto its rest shape.
+TEST(RigidFreeSurfaceEnergy, NewtonWithTheLowRankPartRecoversARigidlyMovedScan) {
+  const TetMesh m = small_mesh();
+  TotalEnergy total;
+  total.add(std::make_shared<ElasticEnergy>(m, std::vector<StableNeoHookean>{StableNeoHookean(3400, 0.45)}));
+  const Rigid P = btr::test::make_rigid(Vec3(5, -10, 30), Vec3(0.03, -0.01, 0.02));
+  total.add(std::make_shared<RigidFreeSurfaceEnergy>(surface_springs(m, m.V, P, 0.0)));
+  std::vector<bool> fixed(m.V.rows(), false);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) fixed[i] = m.V(i, 2) == 0.0;
+  Points x = perturbed(m, 0.002, 14);
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    if (fixed[i]) x.row(i) = m.V.row(i);
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, fixed), m.T);
+  NewtonOptions opt;
+  opt.force_scale = 1.0;
+  const NewtonResult r = solver.solve(total, x, opt);
+  EXPECT_TRUE(r.converged) << to_string(r.reason);
+  EXPECT_LT((x - m.V).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_LE(r.iterations, 12);
 }
 
 TEST(Constraints, BadWeightsAndNormalsAreRejected) {

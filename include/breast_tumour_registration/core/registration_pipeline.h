@@ -81,6 +81,7 @@ struct RegistrationResult {
   bool icp_used = false;
   IcpResult icp;
   bool pose_solved_with_landmarks = false;  ///< the landmark step solved the pose (no decisive ICP)
+  bool pose_solved_with_surface = false;    ///< the surface step refined it (no decisive ICP)
   double pose_disagreement = 0;  ///< [m] ICP vs joint landmark pose, max over the rigid region (when both ran)
   double rigid_seconds = 0;
   std::vector<StepReport> reports;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "breast_tumour_registration/core/registration_model.h"
+#include "breast_tumour_registration/core/rigid_transform.h"
 #include "breast_tumour_registration/core/surface_projector.h"
 
 namespace btr {
@@ -25,6 +26,8 @@ struct SurfaceStepOptions {
   double projection_tolerance = 2e-5;
   /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
   double max_projection_distance = 0.03;
+  /// With a free pose: the weight [N/m] of the point springs (landmarks) that share the pose.
+  double pose_points_weight = 1e4;
   /// Projections onto the border of an open supine surface (the edge of a depth scan, the
   /// rim of a hole behind an occlusion) are dropped: that skin is not in the scan.
   bool reject_boundary = true;
@@ -33,7 +36,17 @@ struct SurfaceStepOptions {
 
 /// supine: projection onto the supine surface in the model frame (a mesh, closed or open,
 /// or a point cloud). x: current positions, updated in place.
+/// pose == nullptr: the surface stays where it is. Otherwise it may move rigidly and its pose
+/// is solved jointly with the deformation (RigidFreeSurfaceEnergy); on return *pose maps the
+/// model frame into the frame the projector was given in.
+/// pose_points (with a free pose only): point correspondences such as the landmarks, targets
+/// in the projector's frame, that share the pose (opt.pose_points_weight).
+struct PosePoints {
+  std::vector<Anchor> anchors;
+  Points targets;
+};
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
-                        Points& x, const StepCallback& callback = {});
+                        Points& x, const StepCallback& callback = {}, Rigid* pose = nullptr,
+                        const PosePoints* pose_points = nullptr);
 
 }  // namespace btr
