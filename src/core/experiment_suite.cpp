@@ -184,7 +184,7 @@ Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& c
   }
   s.material.youngs_modulus = run.method_youngs_modulus;
   const Rigid g = misalignment_from_degrees_mm(run.gravity_rotation_deg, Vec3::Zero());
-  s.gravity = g.linear() * Vec3(0, 0, -9.81);
+  s.gravity = g.linear() * model.supine_gravity;
   s.steps = run.steps;
   s.preset = preset;
   if (!run.misalignment_rotation_deg.isZero() || !run.misalignment_translation_mm.isZero())

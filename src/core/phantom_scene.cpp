@@ -43,8 +43,8 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     return r.x;
   };
   PhantomConfigurations c;
-  c.prone = solve("prone", Vec3(0, 0, 9.81), c.prone_newton);
-  c.supine = solve("supine", Vec3(0, 0, -9.81), c.supine_newton);
+  c.prone = solve("prone", model.prone_gravity, c.prone_newton);
+  c.supine = solve("supine", model.supine_gravity, c.supine_newton);
   for (const auto& [name, t] : model.tumours) {
     const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
     c.tumour_prone[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.prone), t.F};

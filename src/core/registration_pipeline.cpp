@@ -128,6 +128,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
                                     const StepCallback& callback) {
   const auto t_start = Clock::now();
   RegistrationResult r;
+  r.warnings = scene.warnings;
   r.steps = plan_steps(scene);
   r.x = model.rest.V;
 

@@ -6,6 +6,8 @@
 #include "breast_tumour_registration/core/embedding.h"
 #include "breast_tumour_registration/core/index_io.h"
 #include "breast_tumour_registration/core/mesh_io.h"
+#include "breast_tumour_registration/core/scene.h"
+#include "breast_tumour_registration/core/tetrahedralize.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 #include "breast_tumour_registration/core/validation.h"
 #include "breast_tumour_registration/core/yaml_fields.h"
@@ -14,37 +16,80 @@ namespace btr {
 
 namespace fs = std::filesystem;
 
-PhantomModel load_rest_model(const std::string& path) {
+namespace {
+const std::vector<std::string> kModelKeys = {"units",      "rest",       "surface",      "cell_size_mm", "chest_wall",
+                                             "landmarks",  "chest_ring", "tumours.*",    "gravity",      "gravity.prone",
+                                             "gravity.supine"};
+
+PhantomModel load_rest_model_fields(const std::string& path) {
   const YamlFields c{path, fs::path(path).parent_path()};
   const YAML::Node root = YamlFields::load_mapping(path, "rest model");
-  LengthUnit unit = LengthUnit::Millimetre;
-  if (root["units"]) unit = c.load("units", [&] { return parse_length_unit(root["units"].as<std::string>()); });
-  for (const char* f : {"rest", "chest_wall", "landmarks", "tumours"})
-    if (!root[f]) c.fail(f, "missing (a rest model needs rest, chest_wall, landmarks and tumours)");
+  c.check_keys(root, kModelKeys);
+  if (!root["units"]) c.fail("units", "missing: say in which unit the files' lengths are (units: mm or units: m)");
+  const std::string units = c.text(root["units"], "units");
+  const LengthUnit unit = c.load("units", [&] { return parse_length_unit(units); });
+  for (const char* f : {"chest_wall", "landmarks", "tumours", "gravity"})
+    if (!root[f]) c.fail(f, "missing (a rest model needs rest or surface, chest_wall, landmarks, tumours and gravity)");
+  if (!root["gravity"].IsMap() || !root["gravity"]["prone"] || !root["gravity"]["supine"])
+    c.fail("gravity", "expected {prone: [gx, gy, gz], supine: [gx, gy, gz]} in the model's frame [m/s^2]");
+  if (root["rest"] && root["surface"]) c.fail("surface", "give rest (a tetrahedral mesh) or surface (to tetrahedralize), not both");
+  if (!root["rest"] && !root["surface"]) c.fail("rest", "missing: give rest (a tetrahedral mesh) or surface (a closed surface)");
+  if (root["cell_size_mm"] && !root["surface"]) c.fail("cell_size_mm", "only with surface (the size it is tetrahedralized at)");
 
   PhantomModel m;
-  m.rest = c.load("rest", [&] {
-    TetMesh t = read_tet_mesh(c.path_of(root["rest"], "rest"), unit);
-    orient_tets_positive(t);
-    validate_tet_mesh(t, "rest");
-    return t;
-  });
+  m.prone_gravity = c.vec3(root["gravity"]["prone"], "gravity.prone");
+  m.supine_gravity = c.vec3(root["gravity"]["supine"], "gravity.supine");
+  if (!(m.prone_gravity.norm() > 0) || !(m.supine_gravity.norm() > 0)) c.fail("gravity", "must not be zero");
+  // Index files refer to `rest` or, with `surface`, to the surface's vertices; the latter are
+  // re-attached to the tetrahedral mesh after meshing (chest wall: boundary vertices on the
+  // region; landmarks: the nearest boundary vertex).
+  SurfaceMesh input_surface;
+  if (root["rest"]) {
+    m.rest = c.load("rest", [&] {
+      TetMesh t = read_tet_mesh(c.path_of(root["rest"], "rest"), unit);
+      orient_tets_positive(t);
+      validate_tet_mesh(t, "rest");
+      return t;
+    });
+    check_length_scale(m.rest.V, unit, path, "rest");
+  } else {
+    input_surface = c.load("surface", [&] { return read_surface(c.path_of(root["surface"], "surface"), unit); });
+    check_length_scale(input_surface.V, unit, path, "surface");
+    c.load("surface", [&] {
+      repair_orientation(input_surface, "surface", m.warnings);
+      validate_surface(input_surface, "surface");
+      return 0;
+    });
+    TetrahedralizeOptions topt;
+    topt.cell_size = (root["cell_size_mm"] ? c.number(root["cell_size_mm"], "cell_size_mm") : 6.0) * 1e-3;
+    if (!(topt.cell_size > 0)) c.fail("cell_size_mm", "must be positive");
+    m.rest = c.load("cell_size_mm", [&] { return tetrahedralize(input_surface, topt); });
+  }
   std::vector<int> boundary;  // tet vertex of every surface vertex
   m.surface = boundary_surface(m.rest, &boundary);
-  const long n = m.rest.V.rows();
+  const long n = m.rest.V.rows(), n_in = root["rest"] ? n : input_surface.V.rows();
   m.chest_wall = c.load("chest_wall", [&] {
     auto w = read_index_list(c.path_of(root["chest_wall"], "chest_wall"));
-    check_index_range(w, n, "chest_wall");
+    check_index_range(w, n_in, "chest_wall");
     if (w.size() < 3) throw InputError("at least 3 fixed vertices are needed");
+    if (!root["rest"]) w = boundary_vertices_near_region(m.rest, input_surface, w, 1e-6 + 0.1 * 6e-3);
     return w;
   });
   c.load("landmarks", [&] {
     std::vector<char> on_boundary(n, 0);
     for (int v : boundary) on_boundary[v] = 1;
     for (const auto& [name, v] : read_named_indices(c.path_of(root["landmarks"], "landmarks"))) {
-      check_index_range({v}, n, "landmark " + name);
-      if (!on_boundary[v]) throw InputError("landmark " + name + ": vertex " + std::to_string(v) + " is not on the surface");
-      m.landmarks[name] = v;
+      check_index_range({v}, n_in, "landmark " + name);
+      int tv = v;
+      if (!root["rest"]) {  // nearest boundary vertex of the tetrahedralization
+        double best = 1e300;
+        for (int b : boundary) {
+          const double d = (m.rest.V.row(b) - input_surface.V.row(v)).squaredNorm();
+          if (d < best) best = d, tv = b;
+        }
+      }
+      if (!on_boundary[tv]) throw InputError("landmark " + name + ": vertex " + std::to_string(v) + " is not on the surface");
+      m.landmarks[name] = tv;
     }
     return 0;
   });
@@ -56,6 +101,7 @@ PhantomModel load_rest_model(const std::string& path) {
     const std::string name = kv.first.as<std::string>(), field = "tumours." + name;
     SurfaceMesh t = c.load(field, [&] {
       SurfaceMesh s = read_surface(c.path_of(kv.second, field), unit);
+      repair_orientation(s, field, m.warnings);
       validate_surface(s, field);
       embed_points(m.rest, s.V, OutsidePolicy::Error);  // every tumour point inside the rest mesh
       return s;
@@ -63,6 +109,15 @@ PhantomModel load_rest_model(const std::string& path) {
     m.tumours[name] = std::move(t);
   }
   return m;
+}
+}  // namespace
+
+PhantomModel load_rest_model(const std::string& path) {
+  try {
+    return load_rest_model_fields(path);
+  } catch (const YAML::Exception& e) {
+    throw InputError(path + ": " + e.what());
+  }
 }
 
 void write_rest_model(const std::string& dir, const PhantomModel& model, LengthUnit unit) {
@@ -78,6 +133,8 @@ void write_rest_model(const std::string& dir, const PhantomModel& model, LengthU
   y["rest"] = "rest.vtk";
   y["chest_wall"] = "chest_wall.txt";
   y["landmarks"] = "landmark_vertices.txt";
+  y["gravity"]["prone"] = std::vector<double>{model.prone_gravity.x(), model.prone_gravity.y(), model.prone_gravity.z()};
+  y["gravity"]["supine"] = std::vector<double>{model.supine_gravity.x(), model.supine_gravity.y(), model.supine_gravity.z()};
   if (model.chest_ring.V.rows()) {
     write_surface(path("chest_ring.obj"), model.chest_ring, unit);
     y["chest_ring"] = "chest_ring.obj";

@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/core/index_io.h"
 #include "breast_tumour_registration/core/mesh_io.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/surface_orientation.h"
 #include "breast_tumour_registration/core/tetrahedralize.h"
 #include "breast_tumour_registration/core/validation.h"
 #include "breast_tumour_registration/core/yaml_fields.h"
@@ -31,12 +32,46 @@ void apply_misalignment(Scene& s, const Rigid& m) {
   s.misalignment = m * s.misalignment;
 }
 
+namespace {
+// Every key a scene may have; the informational ones (frame, rest, landmark_set,
+// landmark_vertices, generator, supine.tet_mesh_ground_truth) are written by btr_phantom.
+const std::vector<std::string> kSceneKeys = {
+    "units", "frame", "prone", "prone.tet_mesh", "prone.surface", "prone.cell_size_mm", "rest", "rest.tet_mesh",
+    "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmark_set", "landmark_vertices.*", "supine",
+    "supine.surface", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
+    "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
+    "material.youngs_modulus", "material.poisson_ratio", "material.density", "tumour_material",
+    "tumour_material.youngs_modulus", "gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
+    "misalignment.translation_mm", "generator.*"};
+
+Scene load_scene_fields(const std::string& path);
+}  // namespace
+
 Scene load_scene(const std::string& path) {
+  try {
+    return load_scene_fields(path);
+  } catch (const YAML::Exception& e) {  // a field read without a named check: still the file's fault
+    throw InputError(path + ": " + e.what());
+  }
+}
+
+void check_length_scale(const Points& V, LengthUnit units, const std::string& file, const std::string& field) {
+  const double extent = (V.colwise().maxCoeff() - V.colwise().minCoeff()).norm();
+  if (extent < 0.01 || extent > 3.0)
+    throw InputError(file + ": field '" + field + "': the mesh spans " + std::to_string(extent) + " m with units: " +
+                     to_string(units) + "; a breast spans 0.05 to 0.5 m: is `units` right (mm or m)?");
+}
+
+namespace {
+Scene load_scene_fields(const std::string& path) {
   const YamlFields c{path, fs::path(path).parent_path()};
   const YAML::Node root = YamlFields::load_mapping(path, "scene");
+  c.check_keys(root, kSceneKeys);
   Scene s;
   s.path = path;
-  if (root["units"]) s.units = c.load("units", [&] { return parse_length_unit(root["units"].as<std::string>()); });
+  if (!root["units"]) c.fail("units", "missing: say in which unit the files' lengths are (units: mm or units: m)");
+  const std::string units = c.text(root["units"], "units");
+  s.units = c.load("units", [&] { return parse_length_unit(units); });
 
   // Prone model.
   const YAML::Node prone = root["prone"];
@@ -46,6 +81,7 @@ Scene load_scene(const std::string& path) {
   TetrahedralizeOptions topt;
   if (prone["surface"]) {
     prone_surface = c.load("prone.surface", [&] { return read_surface(c.path_of(prone["surface"], "prone.surface"), s.units); });
+    check_length_scale(prone_surface.V, s.units, path, "prone.surface");
     have_surface = true;
   }
   if (prone["tet_mesh"]) {
@@ -55,8 +91,13 @@ Scene load_scene(const std::string& path) {
       validate_tet_mesh(m, "prone.tet_mesh");
       return m;
     });
+    check_length_scale(s.prone.V, s.units, path, "prone.tet_mesh");
   } else if (have_surface) {
-    c.load("prone.surface", [&] { validate_surface(prone_surface, "prone.surface"); return 0; });
+    c.load("prone.surface", [&] {
+      repair_orientation(prone_surface, "prone.surface", s.warnings);
+      validate_surface(prone_surface, "prone.surface");
+      return 0;
+    });
     topt.cell_size = (prone["cell_size_mm"] ? c.number(prone["cell_size_mm"], "prone.cell_size_mm") : 6.0) * 1e-3;
     const auto t0 = std::chrono::steady_clock::now();
     s.prone = c.load("prone.cell_size_mm", [&] { return tetrahedralize(prone_surface, topt); });
@@ -132,7 +173,8 @@ Scene load_scene(const std::string& path) {
     for (const auto& t : root["tumours"]) {
       const std::string f = "tumours[" + std::to_string(i++) + "]";
       SceneTumour st;
-      st.name = t["name"] ? t["name"].as<std::string>() : "tumour" + std::to_string(i - 1);
+      if (!t.IsMap()) c.fail(f, "expected a mapping {name, prone, supine_ground_truth}");
+      st.name = t["name"] ? c.text(t["name"], f + ".name") : "tumour" + std::to_string(i - 1);
       if (!t["prone"]) c.fail(f + ".prone", "missing tumour surface");
       st.prone = c.load(f + ".prone", [&] {
         SurfaceMesh m = read_surface(c.path_of(t["prone"], f + ".prone"), s.units);
@@ -159,12 +201,16 @@ Scene load_scene(const std::string& path) {
     s.tumour_youngs_modulus = c.number(m["youngs_modulus"], "tumour_material.youngs_modulus");
     c.load("tumour_material", [&] { StableNeoHookean(*s.tumour_youngs_modulus, s.material.poisson_ratio); return 0; });
   }
-  if (root["gravity"]) s.gravity = c.vec3(root["gravity"], "gravity");
+  if (!root["gravity"])
+    c.fail("gravity", "missing: the supine gravity in the prone model's frame [m/s^2], e.g. [0, 0, -9.81] when the "
+                      "chest wall is the plane z = 0 and the breast points towards +z");
+  s.gravity = c.vec3(root["gravity"], "gravity");
+  if (!(s.gravity.norm() > 0)) c.fail("gravity", "must not be zero");
   if (const YAML::Node st = root["steps"]) {
-    if (st.IsScalar() && st.as<std::string>() == "auto") {
+    if (st.IsScalar() && c.text(st, "steps") == "auto") {
     } else if (st.IsSequence()) {
       for (const auto& n : st) {
-        const std::string name = n.as<std::string>();
+        const std::string name = c.text(n, "steps");
         if (name != "rigid" && name != "gravity" && name != "landmarks" && name != "surface")
           c.fail("steps", "unknown step '" + name + "' (rigid, gravity, landmarks, surface)");
         s.steps.push_back(name);
@@ -174,7 +220,7 @@ Scene load_scene(const std::string& path) {
       c.fail("steps", "expected 'auto' or a list of steps");
     }
   }
-  if (root["preset"]) s.preset = root["preset"].as<std::string>();
+  if (root["preset"]) s.preset = c.text(root["preset"], "preset");
   if (s.preset != "fast" && s.preset != "balanced" && s.preset != "accurate")
     c.fail("preset", "unknown preset '" + s.preset + "' (fast, balanced, accurate)");
 
@@ -186,6 +232,17 @@ Scene load_scene(const std::string& path) {
     apply_misalignment(s, misalignment_from_degrees_mm(rot, tr));
   }
   return s;
+}
+}  // namespace
+
+void repair_orientation(SurfaceMesh& m, const std::string& name, std::vector<std::string>& warnings) {
+  SurfaceCheckOptions o;
+  o.require_consistent_orientation = false;
+  validate_surface(m, name, o);  // closed, manifold, indices in range: only the orientation is left to repair
+  const long flipped = orient_closed_surface(m, name);
+  if (flipped > 0)
+    warnings.push_back(name + ": " + std::to_string(flipped) + " of " + std::to_string(m.F.rows()) +
+                       " faces were oriented against their neighbours or inwards; repaired");
 }
 
 }  // namespace btr

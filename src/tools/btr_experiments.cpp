@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
     PhantomModel model;
     if (!model_path.empty()) {
       model = load_rest_model(model_path);
+      for (const auto& w : model.warnings) std::printf("[experiments] warning: %s\n", w.c_str());
     } else {
       PhantomOptions po;
       po.tet.cell_size = cell_mm * 1e-3;

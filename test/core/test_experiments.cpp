@@ -122,7 +122,8 @@ TEST(ExperimentSuite, RunsOnARestModelReadFromFiles) {
   // A model with only its own landmark names runs the default set ("all") and skips the thesis's sets.
   write_named_indices(dir + "/few.txt", {{"apex", m.landmarks.at("C")}, {"a", m.landmarks.at("O1")},
                                          {"b", m.landmarks.at("O2")}, {"c", m.landmarks.at("O3")}});
-  test::write_text(dir + "/few.yaml", "rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: few.txt\n"
+  test::write_text(dir + "/few.yaml", "units: mm\ngravity: {prone: [0, 0, 9.81], supine: [0, 0, -9.81]}\n"
+                                      "rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: few.txt\n"
                                       "tumours: {top: tumour_top_rest.obj}\n");
   const PhantomModel few = load_rest_model(dir + "/few.yaml");
   o.experiments = {"landmark_set", "landmark_weight"};
@@ -135,13 +136,55 @@ TEST(ExperimentSuite, RunsOnARestModelReadFromFiles) {
   EXPECT_TRUE(std::any_of(said.begin(), said.end(), [](const std::string& l) { return l.find("skipped landmark_set") == 0; }));
 }
 
+// A model whose chest wall is the plane x = 0 says so with its gravity: the suite must then
+// give what it gives for the same body lying along z (issue 10: before, it was simulated
+// sideways, 41.5 mm off).
+TEST(ExperimentSuite, ModelWithGravityAlongXMatchesTheSameBodyAlongZ) {
+  const std::string dir = test::temp_dir();
+  PhantomModel turned = coarse_phantom();
+  const Mat3 R = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitY()).toRotationMatrix();  // +z -> +x
+  auto turn = [&](Points& P) { P = (P * R.transpose()).eval(); };
+  turn(turned.rest.V);
+  turn(turned.surface.V);
+  turn(turned.chest_ring.V);
+  for (auto& [name, t] : turned.tumours) turn(t.V);
+  turned.prone_gravity = R * coarse_phantom().prone_gravity;
+  turned.supine_gravity = R * coarse_phantom().supine_gravity;
+  write_rest_model(dir, turned, LengthUnit::Millimetre);
+  const PhantomModel m = load_rest_model(dir + "/model.yaml");
+  EXPECT_NEAR((m.supine_gravity - Vec3(-9.81, 0, 0)).norm(), 0, 1e-9);
+
+  ExperimentSuiteOptions o;
+  o.experiments = {"practical"};
+  o.generating_youngs_moduli = {3000};
+  Summary along_z, along_x;
+  run_experiments(coarse_phantom(), o, plan_experiments(o), [&](const ExperimentRow& r) { along_z.add(r); });
+  run_experiments(m, o, plan_experiments(o), [&](const ExperimentRow& r) { along_x.add(r); });
+  EXPECT_LT(along_x.max("practical/full/method=full"), 0.5);
+  EXPECT_NEAR(along_x.max("practical/full/method=full"), along_z.max("practical/full/method=full"), 0.05);
+  EXPECT_NEAR(along_x.max("practical/rigid/method=rigid"), along_z.max("practical/rigid/method=rigid"), 0.05);
+}
+
 TEST(RestModelErrors, NameTheFieldAtFault) {
   const std::string dir = test::temp_dir();
   write_rest_model(dir, coarse_phantom(), LengthUnit::Millimetre);
   auto with = [&](const std::string& yaml) {
-    test::write_text(dir + "/bad.yaml", yaml);
+    test::write_text(dir + "/bad.yaml", "units: mm\ngravity: {prone: [0, 0, 9.81], supine: [0, 0, -9.81]}\n" + yaml);
     return dir + "/bad.yaml";
   };
+  auto raw = [&](const std::string& yaml) {
+    test::write_text(dir + "/raw.yaml", yaml);
+    return dir + "/raw.yaml";
+  };
+  const std::string body = "rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: landmark_vertices.txt\ntumours: {t: tumour_top_rest.obj}\n";
+  test::expect_throw_with<InputError>([&] { load_rest_model(raw("gravity: {prone: [0, 0, 9.81], supine: [0, 0, -9.81]}\n" + body)); },
+                                      "field 'units': missing");
+  test::expect_throw_with<InputError>([&] { load_rest_model(raw("units: mm\n" + body)); }, "field 'gravity': missing");
+  test::expect_throw_with<InputError>([&] { load_rest_model(raw("units: mm\ngravity: [0, 0, 9.81]\n" + body)); },
+                                      "field 'gravity': expected {prone:");
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "cell_size: 5\n")); },
+                                      "field 'cell_size': unknown key (did you mean cell_size_mm?)");
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "cell_size_mm: 5\n")); }, "only with surface");
   test::expect_throw_with<InputError>([&] { load_rest_model(dir + "/none.yaml"); }, "cannot open rest model");
   test::expect_throw_with<InputError>([&] { load_rest_model(with("rest: rest.vtk\n")); }, "field 'chest_wall': missing");
   std::vector<int> on_surface;

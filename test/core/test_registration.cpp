@@ -238,6 +238,46 @@ TEST(SceneErrors, NameTheFieldAtFault) {
   expect_throw_with<InputError>([&] { load_scene(scene_with("landmarks: bad_landmarks.csv", "bad_lm")); }, "field 'landmarks'");
 }
 
+// Issue 10: inputs say what they mean. Unknown and misplaced keys name the nearest valid one,
+// wrong types name the field, units and gravity must be stated, and a metre mesh read as
+// millimetres is called a units mistake (btr_register maps every InputError to exit code 2).
+TEST(SceneErrors, KeysTypesUnitsAndGravityAreChecked) {
+  expect_throw_with<InputError>([&] { load_scene(scene_with("cell_size_mm: 5", "misplaced")); },
+                                "field 'cell_size_mm': unknown key (did you mean prone.cell_size_mm?)");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("prone: {tetmesh: prone.vtk}", "misspelt")); },
+                                "field 'prone.tetmesh': unknown key (did you mean prone.tet_mesh?)");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("units: [mm]", "units_list")); },
+                                "field 'units': expected a single value");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("material: {youngs_modulus: soft}", "E_text")); },
+                                "field 'material.youngs_modulus': expected a number, got 'soft'");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("preset: {name: fast}", "preset_map")); },
+                                "field 'preset': expected a single value");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("tumours: [top]", "tumour_text")); },
+                                "field 'tumours[0]': expected a mapping");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("units: m", "metre_units")); }, "is `units` right (mm or m)?");
+  expect_throw_with<InputError>([&] { load_scene(scene_with("gravity: [0, 0, 0]", "zero_g")); }, "field 'gravity': must not be zero");
+  // Without `units` or `gravity` at all.
+  std::ifstream in(phantom_dir() + "/scene.yaml");
+  std::stringstream all;
+  all << in.rdbuf();
+  const std::string text = all.str();
+  auto without = [&](const std::string& key, const std::string& name) {
+    std::istringstream is(text);
+    std::string out, l;
+    bool skipping = false;
+    while (std::getline(is, l)) {
+      if (l.rfind(key + ":", 0) == 0) { skipping = true; continue; }
+      if (skipping && !l.empty() && (l[0] == ' ' || l[0] == '-')) continue;
+      skipping = false;
+      out += l + "\n";
+    }
+    btr::test::write_text(phantom_dir() + "/" + name + ".yaml", out);
+    return phantom_dir() + "/" + name + ".yaml";
+  };
+  expect_throw_with<InputError>([&] { load_scene(without("units", "no_units")); }, "field 'units': missing");
+  expect_throw_with<InputError>([&] { load_scene(without("gravity", "no_gravity")); }, "field 'gravity': missing");
+}
+
 TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   // The prone model given as a surface: indices refer to the surface and must survive meshing.
   const Scene tets = load_scene(phantom_dir() + "/scene.yaml");
@@ -268,6 +308,28 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
     EXPECT_LT((s.landmark_anchors[i].position(s.prone.V) - tets.landmark_anchors[i].position(tets.prone.V)).norm(), 1.2e-3);
   const RegistrationResult r = register_scene(path);
   EXPECT_LT(worst_error(r), 0.5e-3);
+
+  // The same surface as a modelling tool may export it: every 7th face flipped, and then the
+  // whole surface inside out. Both are repaired with a warning that gives the count.
+  SurfaceMesh flipped = skin;
+  long n_flipped = 0;
+  for (Eigen::Index f = 0; f < flipped.F.rows(); f += 7, ++n_flipped) flipped.F.row(f) = Eigen::RowVector3i(flipped.F(f, 0), flipped.F(f, 2), flipped.F(f, 1));
+  write_surface(d + "/prone_flipped.obj", flipped, LengthUnit::Millimetre);
+  const Scene fs = load_scene(scene_with(
+      "prone: {surface: prone_flipped.obj, cell_size_mm: 12}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
+      "from_flipped"));
+  ASSERT_EQ(fs.warnings.size(), 1u);
+  EXPECT_NE(fs.warnings[0].find("prone.surface: " + std::to_string(n_flipped) + " of " + std::to_string(skin.F.rows()) + " faces"),
+            std::string::npos) << fs.warnings[0];
+  EXPECT_EQ(fs.prone.T.rows() > 0, true);
+  SurfaceMesh inside_out = skin;
+  inside_out.F.col(1).swap(inside_out.F.col(2));
+  write_surface(d + "/prone_inside_out.obj", inside_out, LengthUnit::Millimetre);
+  const Scene io = load_scene(scene_with(
+      "prone: {surface: prone_inside_out.obj, cell_size_mm: 12}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
+      "from_inside_out"));
+  ASSERT_EQ(io.warnings.size(), 1u);
+  EXPECT_NE(io.warnings[0].find(std::to_string(skin.F.rows()) + " of " + std::to_string(skin.F.rows())), std::string::npos);
 }
 
 TEST(Outputs, ReportAndPictureAreWritten) {

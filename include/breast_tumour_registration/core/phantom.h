@@ -32,6 +32,9 @@ struct PhantomModel {
   SurfaceMesh chest_ring;                     ///< rigid chest skin (no FEM; for rigid alignment)
   std::map<std::string, SurfaceMesh> tumours; ///< rest tumour spheres: top, middle, bottom, left, right
   std::map<std::string, int> landmarks;       ///< C, O1-O4, Oa-Od, I1-I4 -> tet boundary vertex
+  Vec3 prone_gravity = Vec3(0, 0, 9.81);      ///< [m/s^2] model frame: the phantom lies prone towards +z
+  Vec3 supine_gravity = Vec3(0, 0, -9.81);    ///< [m/s^2] model frame
+  std::vector<std::string> warnings;          ///< what loading repaired
 };
 
 /// Names of the five tumour locations and of the thesis's landmark sets.

@@ -1,7 +1,7 @@
 // A registration scene (YAML): what is known about one patient (or phantom). Paths are
 // relative to the scene file; lengths in files use `units` and are converted once here.
 //
-//   units: mm                      # m or mm
+//   units: mm                      # m or mm (required)
 //   prone:
 //     tet_mesh: prone.vtk          # or `surface: prone.obj` to tetrahedralize (cell_size_mm)
 //     cell_size_mm: 6
@@ -15,7 +15,7 @@
 //   tumours: [{name: t1, prone: t1.obj, supine_ground_truth: t1_supine.obj}]
 //   material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}
 //   tumour_material: {youngs_modulus: 17000}   # optional: stiffer tumour
-//   gravity: [0, 0, -9.81]         # supine gravity in the prone model frame [m/s^2]
+//   gravity: [0, 0, -9.81]         # supine gravity in the prone model frame [m/s^2] (required)
 //   steps: auto                    # or a list of: rigid, gravity, landmarks, surface
 //   preset: balanced               # fast, balanced, accurate
 //   misalignment: {rotation_deg: [0, 0, 15], translation_mm: [0, 0, 0]}  # optional, experiments
@@ -58,6 +58,7 @@ struct Scene {
   std::vector<std::string> steps;        ///< empty: auto
   std::string preset = "balanced";
   Rigid misalignment = Rigid::Identity();  ///< already applied to all supine data
+  std::vector<std::string> warnings;       ///< what loading repaired (e.g. flipped faces)
 };
 
 /// The misalignment of thesis Sec. 5.2.5: rotations about X, then Y, then Z (degrees,
@@ -68,7 +69,17 @@ Rigid misalignment_from_degrees_mm(const Vec3& rotation_deg, const Vec3& transla
 /// truth) by `m`, as if the supine scan had been taken misaligned; composes s.misalignment.
 void apply_misalignment(Scene& s, const Rigid& m);
 
-/// Loads and validates a scene. Throws InputError naming the file and field at fault.
+/// Loads and validates a scene. Throws InputError naming the file and field at fault: a
+/// missing `units` or `gravity`, an unknown or misplaced key (with the nearest valid one), a
+/// value of the wrong type, a mesh whose size says the units are wrong.
 Scene load_scene(const std::string& path);
+
+/// Throws InputError (naming file and field) when a mesh's extent is not that of a breast
+/// (1 cm to 3 m): most often a metre file read as millimetres, or the other way round.
+void check_length_scale(const Points& V, LengthUnit units, const std::string& file, const std::string& field);
+
+/// A closed surface with faces flipped against their neighbours or inwards is repaired
+/// (orient_closed_surface); the count goes to `warnings`. Other defects throw InputError.
+void repair_orientation(SurfaceMesh& m, const std::string& name, std::vector<std::string>& warnings);
 
 }  // namespace btr

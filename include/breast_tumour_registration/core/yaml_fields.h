@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/types.h"
@@ -38,11 +39,21 @@ struct YamlFields {
     const std::filesystem::path p(n.as<std::string>());
     return (p.is_absolute() ? p : dir / p).string();
   }
+  /// A scalar as text (a name, a unit, a step); a list or mapping is an error naming the field.
+  std::string text(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail(field, "expected a single value, not a list or mapping");
+    return n.as<std::string>();
+  }
+  /// Every key of `root` (recursively) must be one of `valid`: dotted paths, "a[]" for the
+  /// maps in a list, and "a.*" for a free-form mapping. An unknown key is an error that names
+  /// the nearest valid key ("did you mean prone.cell_size_mm?").
+  void check_keys(const YAML::Node& root, const std::vector<std::string>& valid) const;
   double number(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail(field, "expected a number, not a list or mapping");
     try {
       return n.as<double>();
     } catch (const YAML::Exception&) {
-      fail(field, "expected a number");
+      fail(field, "expected a number, got '" + n.as<std::string>() + "'");
     }
   }
   Vec3 vec3(const YAML::Node& n, const std::string& field) const {
