@@ -61,7 +61,7 @@ PhantomModel load_rest_model_fields(const std::string& path) {
       return 0;
     });
     TetrahedralizeOptions topt;
-    topt.cell_size = (root["cell_size_mm"] ? c.number(root["cell_size_mm"], "cell_size_mm") : 6.0) * 1e-3;
+    topt.cell_size = root["cell_size_mm"] ? c.number(root["cell_size_mm"], "cell_size_mm") * 1e-3 : kDefaultCellSize;
     if (!(topt.cell_size > 0)) c.fail("cell_size_mm", "must be positive");
     m.rest = c.load("cell_size_mm", [&] { return tetrahedralize(input_surface, topt); });
   }

@@ -47,12 +47,38 @@ const std::vector<std::string> kSceneKeys = {
 Scene load_scene_fields(const std::string& path);
 }  // namespace
 
-Scene load_scene(const std::string& path) {
+Scene load_scene(const std::string& path, const SceneLoadOptions& opt) {
+  Scene s;
   try {
-    return load_scene_fields(path);
+    s = load_scene_fields(path);
   } catch (const YAML::Exception& e) {  // a field read without a named check: still the file's fault
     throw InputError(path + ": " + e.what());
   }
+  if (s.prone_source && opt.tetrahedralize) mesh_prone(s, s.prone_source->cell_size.value_or(kDefaultCellSize));
+  return s;
+}
+
+void mesh_prone(Scene& s, double cell_size) {
+  if (!s.prone_source) throw InputError(s.path + ": the prone model is a tetrahedral mesh already");
+  if (!(cell_size > 0) || !std::isfinite(cell_size))
+    throw InputError(s.path + ": field 'prone.cell_size_mm': must be positive");
+  const ProneSurfaceSource& src = *s.prone_source;
+  TetrahedralizeOptions topt;
+  topt.cell_size = cell_size;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    s.prone = tetrahedralize(src.surface, topt);
+  } catch (const InputError& e) {
+    throw InputError(s.path + ": field 'prone.surface': " + e.what());
+  }
+  s.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.tetrahedralized = true;
+  try {
+    s.chest_wall = boundary_vertices_near_region(s.prone, src.surface, src.chest_wall, 1e-6 + topt.facet_distance_ratio * cell_size);
+  } catch (const InputError& e) {
+    throw InputError(s.path + ": field 'chest_wall': " + e.what());
+  }
+  if (src.landmarks.rows()) s.landmark_anchors = attach_to_boundary(s.prone, src.landmarks).anchors;
 }
 
 void check_length_scale(const Points& V, LengthUnit units, const std::string& file, const std::string& field) {
@@ -78,7 +104,6 @@ Scene load_scene_fields(const std::string& path) {
   if (!prone || !prone.IsMap()) c.fail("prone", "missing; give prone.tet_mesh or prone.surface");
   SurfaceMesh prone_surface;
   bool have_surface = false;
-  TetrahedralizeOptions topt;
   if (prone["surface"]) {
     prone_surface = c.load("prone.surface", [&] { return read_surface(c.path_of(prone["surface"], "prone.surface"), s.units); });
     check_length_scale(prone_surface.V, s.units, path, "prone.surface");
@@ -93,28 +118,30 @@ Scene load_scene_fields(const std::string& path) {
     });
     check_length_scale(s.prone.V, s.units, path, "prone.tet_mesh");
   } else if (have_surface) {
+    // Meshed by mesh_prone (below, or by the caller at the size its preset simulates).
     c.load("prone.surface", [&] {
       repair_orientation(prone_surface, "prone.surface", s.warnings);
       validate_surface(prone_surface, "prone.surface");
       return 0;
     });
-    topt.cell_size = (prone["cell_size_mm"] ? c.number(prone["cell_size_mm"], "prone.cell_size_mm") : 6.0) * 1e-3;
-    const auto t0 = std::chrono::steady_clock::now();
-    s.prone = c.load("prone.cell_size_mm", [&] { return tetrahedralize(prone_surface, topt); });
-    s.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    s.tetrahedralized = true;
+    s.prone_source = ProneSurfaceSource{};
+    s.prone_source->surface = prone_surface;
+    if (prone["cell_size_mm"]) {
+      const double cell = c.number(prone["cell_size_mm"], "prone.cell_size_mm") * 1e-3;
+      if (!(cell > 0) || !std::isfinite(cell)) c.fail("prone.cell_size_mm", "must be positive");
+      s.prone_source->cell_size = cell;
+    }
   } else {
     c.fail("prone", "give prone.tet_mesh or prone.surface");
   }
+  if (prone["cell_size_mm"] && !have_surface) c.fail("prone.cell_size_mm", "only with prone.surface (the size it is tetrahedralized at)");
 
   // Chest wall: tet vertex indices, or surface indices re-attached after tetrahedralization.
   if (!root["chest_wall"]) c.fail("chest_wall", "missing: the fixed chest-wall vertices are required");
   const std::vector<int> wall = c.load("chest_wall", [&] { return read_index_list(c.path_of(root["chest_wall"], "chest_wall")); });
-  if (s.tetrahedralized) {
+  if (s.prone_source) {
     c.load("chest_wall", [&] { check_index_range(wall, prone_surface.V.rows(), "chest_wall"); return 0; });
-    s.chest_wall = c.load("chest_wall", [&] {
-      return boundary_vertices_near_region(s.prone, prone_surface, wall, 1e-6 + topt.facet_distance_ratio * topt.cell_size);
-    });
+    s.prone_source->chest_wall = wall;
   } else {
     c.load("chest_wall", [&] { check_index_range(wall, s.prone.V.rows(), "chest_wall"); return 0; });
     s.chest_wall = wall;
@@ -148,7 +175,7 @@ Scene load_scene_fields(const std::string& path) {
     s.landmark_supine.resize(pairs.size(), 3);
     for (size_t i = 0; i < pairs.size(); ++i) {
       const auto& p = pairs[i];
-      const long n_prone = s.tetrahedralized ? prone_surface.V.rows() : s.prone.V.rows();
+      const long n_prone = s.prone_source ? prone_surface.V.rows() : s.prone.V.rows();
       if (p.prone_vertex >= n_prone)
         c.fail("landmarks", "pair " + std::to_string(i) + ": prone vertex " + std::to_string(p.prone_vertex) +
                                 " out of range (" + std::to_string(n_prone) + " vertices)");
@@ -160,10 +187,10 @@ Scene load_scene_fields(const std::string& path) {
       } else {
         s.landmark_supine.row(i) = p.supine_point.transpose();
       }
-      if (s.tetrahedralized) prone_pts.row(i) = prone_surface.V.row(p.prone_vertex);
+      if (s.prone_source) prone_pts.row(i) = prone_surface.V.row(p.prone_vertex);
       else s.landmark_anchors.push_back(Anchor::vertex(p.prone_vertex));
     }
-    if (s.tetrahedralized) s.landmark_anchors = attach_to_boundary(s.prone, prone_pts).anchors;
+    if (s.prone_source) s.prone_source->landmarks = prone_pts;
   }
 
   // Tumours.

@@ -28,8 +28,8 @@ int main(int argc, char** argv) {
   app.add_option("-s,--steps", steps, "override the scene's steps: auto, or a comma list of rigid,gravity,landmarks,surface");
   app.add_option("--tumour-youngs-modulus", tumour_E, "give tumour elements this Young's modulus [Pa] (stiffer tumour)");
   app.add_option("--cell-size", cell_mm,
-                 "simulate on the prone model re-tetrahedralized at this cell size [mm] (default: the preset's; 0: the "
-                 "scene's mesh as given)")
+                 "simulate on the prone model (re-)tetrahedralized at this cell size [mm] (default: a prone surface's "
+                 "prone.cell_size_mm, else the preset's; 0: the scene's mesh as given)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", quiet, "no progress display");
   CLI11_PARSE(app, argc, argv);
@@ -37,7 +37,9 @@ int main(int argc, char** argv) {
   const bool tty = isatty(fileno(stdout));
   try {
     auto t0 = std::chrono::steady_clock::now();
-    Scene scene = load_scene(scene_path);
+    SceneLoadOptions load;
+    load.tetrahedralize = false;  // a prone surface is meshed once, below, at the size the call simulates
+    Scene scene = load_scene(scene_path, load);
     if (!preset.empty()) scene.preset = preset;
     if (!steps.empty()) {
       scene.steps.clear();
@@ -52,7 +54,14 @@ int main(int argc, char** argv) {
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
     RegistrationOptions opt = preset_options(scene.preset);
     if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
-    if (auto coarse = simulation_scene(scene, opt)) {
+    if (scene.prone_source) {
+      // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh.
+      const double cell = cell_mm > 0 ? cell_mm * 1e-3
+                                       : scene.prone_source->cell_size.value_or(
+                                             opt.simulation_cell_size > 0 ? opt.simulation_cell_size : kDefaultCellSize);
+      mesh_prone(scene, cell);
+      std::printf("[register] tetrahedralized the prone surface at %.1f mm (%.2f s)\n", cell * 1e3, scene.tetrahedralize_seconds);
+    } else if (auto coarse = simulation_scene(scene, opt)) {
       scene = std::move(*coarse);
       std::printf("[register] simulating on the prone model re-tetrahedralized at %.1f mm (%.2f s; --cell-size 0 keeps "
                   "the scene's mesh)\n", opt.simulation_cell_size * 1e3, scene.tetrahedralize_seconds);

@@ -309,6 +309,23 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   const RegistrationResult r = register_scene(path);
   EXPECT_LT(worst_error(r), 0.5e-3);
 
+  // Meshed once (issue 10): loaded without meshing, then meshed by the caller at the size it
+  // simulates, after which the preset sees no finer mesh to coarsen.
+  SceneLoadOptions lazy;
+  lazy.tetrahedralize = false;
+  Scene l = load_scene(path, lazy);
+  EXPECT_FALSE(l.tetrahedralized);
+  EXPECT_EQ(l.prone.T.rows(), 0);
+  ASSERT_TRUE(l.prone_source.has_value());
+  EXPECT_EQ(l.prone_source->cell_size.value_or(0), 0.012);
+  mesh_prone(l, 0.012);
+  EXPECT_TRUE(l.tetrahedralized);
+  EXPECT_NEAR(static_cast<double>(l.prone.T.rows()), static_cast<double>(s.prone.T.rows()), 0.02 * s.prone.T.rows());
+  EXPECT_EQ(l.landmark_anchors.size(), s.landmark_anchors.size());
+  RegistrationOptions at12 = preset_options("balanced");
+  at12.simulation_cell_size = 0.012;
+  EXPECT_FALSE(simulation_scene(l, at12).has_value());
+
   // The same surface as a modelling tool may export it: every 7th face flipped, and then the
   // whole surface inside out. Both are repaired with a warning that gives the count.
   SurfaceMesh flipped = skin;

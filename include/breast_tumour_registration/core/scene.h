@@ -38,11 +38,24 @@ struct SceneTumour {
   std::optional<SurfaceMesh> supine_ground_truth;  ///< supine frame
 };
 
+/// A prone model given as a closed surface: what meshing needs (the chest wall and the
+/// landmarks refer to the surface's vertices and are re-attached to the tetrahedra).
+struct ProneSurfaceSource {
+  SurfaceMesh surface;
+  std::vector<int> chest_wall;  ///< surface vertex indices
+  Points landmarks;             ///< prone landmark points on the surface, one row per pair
+  std::optional<double> cell_size;  ///< prone.cell_size_mm when the scene gives it [m]
+};
+
+/// Cell size a prone surface is tetrahedralized at when nothing else says [m].
+constexpr double kDefaultCellSize = 0.006;
+
 struct Scene {
   std::string path;
   LengthUnit units = LengthUnit::Millimetre;
-  TetMesh prone;                         ///< model frame
-  bool tetrahedralized = false;          ///< prone came from a surface
+  TetMesh prone;                         ///< model frame (empty until mesh_prone for a surface not yet meshed)
+  std::optional<ProneSurfaceSource> prone_source;  ///< the prone model was given as a surface
+  bool tetrahedralized = false;          ///< prone was meshed from prone_source
   double tetrahedralize_seconds = 0;
   std::vector<int> chest_wall;           ///< prone tet vertex indices
   std::vector<Anchor> landmark_anchors;  ///< prone landmark points
@@ -72,7 +85,17 @@ void apply_misalignment(Scene& s, const Rigid& m);
 /// Loads and validates a scene. Throws InputError naming the file and field at fault: a
 /// missing `units` or `gravity`, an unknown or misplaced key (with the nearest valid one), a
 /// value of the wrong type, a mesh whose size says the units are wrong.
-Scene load_scene(const std::string& path);
+struct SceneLoadOptions {
+  /// Mesh a prone surface at load (at prone.cell_size_mm, else kDefaultCellSize). false:
+  /// leave it to the caller's mesh_prone, e.g. at the size its preset simulates, so that the
+  /// surface is tetrahedralized once.
+  bool tetrahedralize = true;
+};
+Scene load_scene(const std::string& path, const SceneLoadOptions& opt = {});
+
+/// Tetrahedralizes s.prone_source at cell_size [m] and re-attaches the chest wall and the
+/// landmarks to the tetrahedra. InputError naming the field on failure.
+void mesh_prone(Scene& s, double cell_size);
 
 /// Throws InputError (naming file and field) when a mesh's extent is not that of a breast
 /// (1 cm to 3 m): most often a metre file read as millimetres, or the other way round.
