@@ -32,11 +32,20 @@ source "$REPO_ROOT/build/ws/devel/setup.bash"
 set -u
 export ROS_HOME="${ROS_HOME:-$OUT/ros_home}" ROS_LOG_DIR="${ROS_LOG_DIR:-$OUT/ros_log}"
 export ROS_MASTER_URI="http://localhost:${BTR_ROS_PORT:-11411}"
+# The node and the bag replay run under roslaunch in the background; the client runs here and
+# its exit code is the demo's. Then the launch is stopped with SIGINT (its normal shutdown).
+FILTER="TF_REPEATED_DATA|^\s*$|^ \* |PARAMETERS|NODES|SUMMARY|^    |process\[|auto-starting|setting /run_id|Checking log|Done checking|xml is deprecated|started core service|ROS_MASTER_URI|killing on exit|shutting down processing monitor|^\S*done\S*$"
+roslaunch --port "${BTR_ROS_PORT:-11411}" breast_tumour_registration demo.launch client:=false \
+  scene:="$OUT/scene/scene.yaml" bag:="$OUT/depth.bag" > >(grep --line-buffered -vE "$FILTER") 2>&1 &
+launch_pid=$!
+for _ in $(seq 1 60); do rosnode list > /dev/null 2>&1 && break; sleep 0.5; done  # the master is up
 rc=0
-timeout 180 roslaunch --port "${BTR_ROS_PORT:-11411}" breast_tumour_registration demo.launch \
-  scene:="$OUT/scene/scene.yaml" bag:="$OUT/depth.bag" 2>&1 |
-  grep --line-buffered -vE "TF_REPEATED_DATA|^\s*$|^ \* |PARAMETERS|NODES|SUMMARY|^    |process\[|auto-starting|setting /run_id|Checking log|Done checking|xml is deprecated|started core service|ROS_MASTER_URI" || rc=$?
-rc=${PIPESTATUS[0]}
+timeout 180 "$BIN/btr_demo_client" _truth:="$OUT/depth.bag.truth.yaml" _preset:=balanced __name:=demo_client || rc=$?
+echo "[demo] stopping the node, the bag replay and the ROS master"
+kill -INT "$launch_pid" 2>/dev/null || true
+for _ in $(seq 1 30); do kill -0 "$launch_pid" 2>/dev/null || break; sleep 0.5; done
+kill -KILL "$launch_pid" 2>/dev/null || true
+wait "$launch_pid" 2>/dev/null || true
 echo
 echo "[demo] done (exit $rc). Files: $OUT/registration/report.json, $OUT/registration/cross_section.png,"
 echo "[demo] $OUT/registration/registered.vtk and tumour_*_registered.obj (ParaView, 3D Slicer); bag: $OUT/depth.bag"

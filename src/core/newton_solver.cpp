@@ -134,12 +134,21 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
 
   Points x_trial(x.rows(), 3);
   bool fresh_factor = false;  // the last direction stalled on the lagged factor: refactorize
+  // Near the solution the unprojected Hessian (positive definite there as a whole, although
+  // compressed elements are indefinite on their own) restores quadratic convergence; the
+  // projected one converges linearly in that tail. Any sign of trouble switches back.
+  bool exact = false;
+  double exact_retry_below = std::numeric_limits<double>::infinity();  // after a failed try: wait for progress
+  auto leave_exact = [&] {
+    exact = false;
+    exact_retry_below = 0.5 * g.norm();
+  };
   for (int it = 1; it <= opt.max_iterations; ++it) {
     IterationInfo info;
     info.iteration = it;
 
     auto t0 = Clock::now();
-    energy.hessian(x, opt.project_psd, H);
+    energy.hessian(x, opt.project_psd && !exact, H);
     const LowRankHessian low = energy.low_rank_hessian(x, H);  // H - W M W^T (usually empty)
     info.t_assembly = since(t0);
 
@@ -173,6 +182,11 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
       const double diag_scale = H.matrix().diagonal().cwiseAbs().maxCoeff();
       llt.setShift(0);
       llt.factorize(H.matrix());
+      if (llt.info() != Eigen::Success && exact) {  // not positive definite after all: project again
+        leave_exact();
+        energy.hessian(x, true, H);
+        llt.factorize(H.matrix());
+      }
       while (llt.info() != Eigen::Success) {
         shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
         if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30)) {
@@ -205,16 +219,32 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
     const StepOutcome outcome = apply_newton_step(energy, tets_, opt, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
     if (outcome != StepOutcome::Taken) {
+      if (exact) {  // retry on the projected Hessian before calling it a stall
+        leave_exact();
+        fresh_factor = true;
+        continue;
+      }
       if (!recover_from_stall(outcome, !info.factorized, res)) break;
       fresh_factor = true;
       continue;
     }
     fresh_factor = false;
+    const double g_before = g.norm();
     g = H.gather(energy.gradient(x));
+    // Near the solution (full step accepted, |g| below 1% of the load) or where the projected
+    // Hessian only converges linearly (|g| not halved by a full step).
+    if (opt.project_psd && opt.exact_hessian_near_solution && !exact && info.alpha == 1.0 && g.norm() < exact_retry_below &&
+        (g.norm() <= 1e-2 * std::max(res.initial_gradient_norm, opt.force_scale) || g.norm() > 0.5 * g_before))
+      exact = true;
     info.gradient_norm = g.norm();
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
     if (info.step_norm <= opt.step_tolerance) {  // accepted, but too short to make progress
+      if (exact) {
+        leave_exact();
+        fresh_factor = true;
+        continue;
+      }
       if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, res)) break;
       fresh_factor = true;
     }

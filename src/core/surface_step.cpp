@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/core/surface_step.h"
 
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <memory>
 
@@ -45,8 +46,14 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   std::vector<int> held;
   Points held_y, held_n;
   rep.t_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  Points targets = Points::Zero(static_cast<Eigen::Index>(model.skin.size()), 3);
+  // The held skin where the previous projection saw it (projector frame): convergence is the
+  // skin no longer moving between projections. The projections themselves jitter along a
+  // noisy scan (a depth camera's) without moving the skin, so their change is no criterion.
+  Points skin_before = Points::Constant(static_cast<Eigen::Index>(model.skin.size()), 3, std::numeric_limits<double>::quiet_NaN());
   int offset = 0;
+  bool finished = false;  // the loop ended for a reason of its own, not on the cap
+  double least_motion = std::numeric_limits<double>::infinity();
+  int least_at = 0;
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
     const auto tp = std::chrono::steady_clock::now();
     points->clear();
@@ -59,9 +66,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     held_n.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
     for (size_t i = 0; i < model.skin.size(); ++i) {
       const int v = model.skin[i];
-      const Projection c = supine.project(P * Vec3(x.row(v).transpose()));
-      const double m = (c.point - targets.row(i).transpose()).norm();
-      targets.row(i) = c.point.transpose();
+      const Vec3 here = P * Vec3(x.row(v).transpose());
+      const Projection c = supine.project(here);
+      const double m = outer > 1 ? (here - skin_before.row(i).transpose()).norm() : std::numeric_limits<double>::infinity();
+      skin_before.row(i) = here.transpose();
       if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) continue;
       if (opt.reject_boundary && c.on_boundary) continue;
       // Convergence is judged on the constraints that act (a dropped projection onto a
@@ -106,6 +114,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.energy = r.energy;
     rep.gradient_norm = r.gradient_norm;
     rep.stop_reason = to_string(r.reason);
+    finished = true;
     if (r.reason == StopReason::Aborted) break;
     if (r.reason == StopReason::Stalled || r.reason == StopReason::LineSearchFailed) {
       rep.stop_reason = "Newton " + rep.stop_reason + " (gradient " + std::to_string(r.gradient_norm) + " N)";
@@ -113,14 +122,25 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     }
     if (settled) {
       rep.converged = r.converged;
-      rep.stop_reason = r.converged ? "projections stopped moving and the gradient criterion held"
-                                    : "projections stopped moving but Newton reached its iteration cap";
+      rep.stop_reason = r.converged ? "the skin stopped moving between projections and the gradient criterion held"
+                                    : "the skin stopped moving between projections but Newton reached its iteration cap";
       break;
     }
+    // A stall: the skin's motion has not come down for stall_projections projections (on a
+    // noisy scan it settles into a jitter above the tolerance). Not converged; no use going on.
+    if (outer > 1 && moved_rms < least_motion) {
+      least_motion = moved_rms;
+      least_at = outer;
+    } else if (outer > 1 && outer - least_at >= opt.stall_projections) {
+      rep.stop_reason = "stalled: the skin keeps moving " + std::to_string(moved_rms * 1e3) + " mm RMS between projections (least " +
+                        std::to_string(least_motion * 1e3) + " mm, " + std::to_string(opt.stall_projections) +
+                        " projections ago; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm): a noisy scan?";
+      break;
+    }
+    finished = false;
   }
-  if (!rep.converged && rep.outer_iterations == opt.max_projections && rep.stop_reason.rfind("projections", 0) != 0 &&
-      rep.stop_reason.rfind("Newton", 0) != 0 && rep.stop_reason != to_string(StopReason::Aborted))
-    rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached with the projections still moving " +
+  if (!finished)
+    rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached with the skin still moving " +
                       std::to_string(rep.projection_rms_change * 1e3) + " mm RMS (tolerance " +
                       std::to_string(opt.projection_tolerance * 1e3) + " mm)";
   if (pose) *pose = free_springs->size() >= 3 ? free_springs->pose(x) : P;

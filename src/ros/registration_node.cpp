@@ -18,6 +18,12 @@
 namespace btr {
 namespace {
 
+/// The call came before the data it needs (no cloud yet, tracking settling): the caller waits
+/// and calls again; not an error.
+struct NotReady : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 Vec3 read_vec3(const ros::NodeHandle& pnh, const std::string& name, const Vec3& def) {
   std::vector<double> v;
   if (!pnh.getParam(name, v)) return def;
@@ -273,8 +279,8 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       {
         std::lock_guard<std::mutex> lock(state_mutex_);
         if (!have_cloud_)
-          throw InputError("no depth cloud has been received on '" + cloud_sub_.getTopic() +
-                           "' yet; start the camera or play a bag, then call again");
+          throw NotReady("no depth cloud has been received on '" + cloud_sub_.getTopic() +
+                         "' yet; start the camera or play a bag, then call again");
         cloud = latest_cloud_;
         w = latest_width_;
         h = latest_height_;
@@ -284,11 +290,11 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
         }
       }
       if (!T)
-        throw InputError("the model is not aligned with the depth cloud yet (ICP rejected every cloud); make sure the "
-                         "chest around the breast is in view and ~initial_model_pose is close");
+        throw NotReady("the model is not aligned with the depth cloud yet (ICP rejected every cloud); make sure the "
+                       "chest around the breast is in view and ~initial_model_pose is close");
       if (tracked < params_.min_tracked_clouds)
-        throw InputError("the depth tracking is settling (" + std::to_string(tracked) + " of " +
-                         std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
+        throw NotReady("the depth tracking is settling (" + std::to_string(tracked) + " of " +
+                       std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
       if (w > 0) {
         scene.supine_surface = triangulate_organized(cloud, w, h, params_.max_depth_edge);
       } else {
@@ -329,8 +335,13 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
                        " skin vertices held to the scan";
       if (!step.converged) res.message += "; the " + step.name + " step stopped without converging (" + step.stop_reason + ")";
     }
-    if (!r.converged) res.message += "; the accurate preset runs longer";
+    if (!r.converged) res.message += "; not converged: the result is the last state, see the step reports";
     publish_status(r.converged ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN, res.message);
+  } catch (const NotReady& e) {  // waiting for data is not an error
+    res.success = false;
+    res.message = e.what();
+    ROS_INFO_STREAM_THROTTLE(2.0, "registration waiting: " << e.what());
+    publish_status(diagnostic_msgs::DiagnosticStatus::WARN, res.message);
   } catch (const InputError& e) {
     res.success = false;
     res.message = e.what();

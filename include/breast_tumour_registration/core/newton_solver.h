@@ -50,6 +50,10 @@ struct NewtonOptions {
   int max_line_search_steps = 40;
   double armijo = 1e-4;
   bool project_psd = true;
+  /// With project_psd: once a full step was accepted and |g| is below 1% of the load, use the
+  /// unprojected Hessian (full-space solver only), back to the projected one if it is not
+  /// positive definite or its step makes no progress.
+  bool exact_hessian_near_solution = true;
   /// Reuse the last Cholesky factor as a preconditioner for conjugate gradients on the
   /// new Hessian (inexact Newton); refactorize only when PCG does not reach the forcing
   /// tolerance within max_pcg_iterations. Off: a fresh factorization every iteration.

@@ -64,8 +64,8 @@ struct StepReport {
   double seconds = 0;
   double energy = 0;
   double gradient_norm = 0;
-  double projection_rms_change = 0;  ///< surface step: last RMS change of the projections [m]
-  double projection_max_change = 0;  ///< surface step: last max change [m]
+  double projection_rms_change = 0;  ///< surface step: RMS motion of the held skin between the last two projections [m]
+  double projection_max_change = 0;  ///< surface step: the largest such motion [m]
   /// surface step: skin vertices constrained by the last projection (the others were too
   /// far from the supine surface or projected onto its border) and all skin vertices
   int constrained_skin = 0, skin_vertices = 0;

@@ -20,10 +20,14 @@ struct SurfaceStepOptions {
   /// not converged, with the last change of the projections.
   int max_projections = 40;
   int newton_per_projection = 1; ///< Newton iterations between projections (thesis: 1)
-  /// [m] Convergence: the RMS change of the projections falls below this (the max is reported:
-  /// a few rim vertices keep flipping between the faces of a sharp edge), then Newton on the
-  /// settled projections meets its gradient criterion (up to newton.max_iterations).
+  /// [m] Convergence: the held skin moved less than this (RMS) since the previous projection,
+  /// then Newton on the settled projections meets its gradient criterion (up to
+  /// newton.max_iterations). The skin's motion, not the projections' change: on a noisy scan
+  /// the projections jitter along the surface while the skin stays put.
   double projection_tolerance = 2e-5;
+  /// A stall: the skin's motion between projections has not reached a new low for this many
+  /// projections (reported as not converged).
+  int stall_projections = 8;
   /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
   double max_projection_distance = 0.03;
   /// With a free pose: the weight [N/m] of the point springs (landmarks) that share the pose.
