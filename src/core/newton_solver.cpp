@@ -23,6 +23,9 @@ std::string to_string(StopReason r) {
     case StopReason::GradientTolerance: return "gradient tolerance reached";
     case StopReason::StepTolerance: return "full Newton step below the step tolerance";
     case StopReason::Stalled: return "stalled: line-search steps below the step tolerance with the gradient above its tolerance";
+    case StopReason::InvertedAfterStall:
+      return "stalled: every step inverted an element, and letting them invert folded the mesh; the last uninverted "
+             "state is kept";
     case StopReason::MaxIterations: return "maximum iterations reached";
     case StopReason::LineSearchFailed: return "line search found no decrease";
     case StopReason::Aborted: return "aborted by callback";
@@ -71,8 +74,17 @@ bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, doubl
   return false;
 }
 
-bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonResult& res) {
-  if (direction_was_lagged) return true;  // a fresh factorization first
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res) {
+  if (direction_was_lagged) return true;  // first: a fresh factorization
+  if (outcome != StepOutcome::TooSmall && opt.forbid_new_inversions) {
+    // Second: let the line search invert elements. The stable Neo-Hookean energy is defined
+    // there, and soft tissue pulled by stiff springs otherwise freezes on one nearly flat
+    // element (measured: E = 400 Pa, surface step stalled at 590 N, tumour 13.8 mm off;
+    // with inversions allowed it converges, 0.77 mm). The result reports the inverted count.
+    opt.forbid_new_inversions = false;
+    res.inversions_allowed = true;
+    return true;
+  }
   switch (outcome) {
     case StepOutcome::TooSmall:  // the exact Newton step: the minimum is within step_tolerance
       res.reason = StopReason::StepTolerance;
@@ -87,6 +99,25 @@ bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonRe
       res.converged = false;
   }
   return false;
+}
+
+void InversionGuard::arm(const NewtonResult& res, const Points& x_now, double E, long n_inv) {
+  if (armed || !res.inversions_allowed) return;
+  armed = true;
+  x = x_now;
+  energy = E;
+  inverted = n_inv;
+}
+
+bool InversionGuard::restore_if_worse(Points& x_now, double& E, long& n_inv, NewtonResult& res, long n_tets,
+                                      double max_fraction) const {
+  if (!armed || static_cast<double>(n_inv - inverted) <= max_fraction * static_cast<double>(n_tets)) return false;
+  x_now = x;
+  E = energy;
+  n_inv = inverted;
+  res.reason = StopReason::InvertedAfterStall;
+  res.converged = false;
+  return true;
 }
 
 LineSearchOptions line_search_options(const NewtonOptions& opt) {
@@ -105,7 +136,11 @@ struct NewtonSolver::Impl {
 };
 
 NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
-    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {}
+    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {
+  // A failed factorization is expected (the unprojected Hessian tried near the solution) and
+  // handled here; CHOLMOD's own "not positive definite" lines on stderr would only alarm.
+  impl_->llt.cholmod().print = 0;
+}
 
 NewtonSolver::~NewtonSolver() = default;
 
@@ -133,6 +168,8 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
   }
 
   Points x_trial(x.rows(), 3);
+  NewtonOptions local = opt;  // a stall may relax the inversion rule for the rest of the solve
+  InversionGuard guard;
   bool fresh_factor = false;  // the last direction stalled on the lagged factor: refactorize
   // Near the solution the unprojected Hessian (positive definite there as a whole, although
   // compressed elements are indefinite on their own) restores quadratic convergence; the
@@ -217,14 +254,15 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
     H.scatter_add(d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
-    const StepOutcome outcome = apply_newton_step(energy, tets_, opt, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
+    const StepOutcome outcome = apply_newton_step(energy, tets_, local, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
     if (outcome != StepOutcome::Taken) {
       if (exact) {  // retry on the projected Hessian before calling it a stall
         leave_exact();
         fresh_factor = true;
         continue;
       }
-      if (!recover_from_stall(outcome, !info.factorized, res)) break;
+      if (!recover_from_stall(outcome, !info.factorized, local, res)) break;
+      guard.arm(res, x, E, n_inv);
       fresh_factor = true;
       continue;
     }
@@ -245,10 +283,13 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
         fresh_factor = true;
         continue;
       }
-      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, res)) break;
+      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, local, res)) break;
+      guard.arm(res, x, E, n_inv);
       fresh_factor = true;
     }
   }
+  if (guard.restore_if_worse(x, E, n_inv, res, tets_.rows(), opt.max_inverted_fraction_after_stall))
+    g = H.gather(energy.gradient(x));
   res.energy = E;
   res.gradient_norm = g.norm();
   res.inverted = n_inv;

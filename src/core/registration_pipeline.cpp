@@ -247,7 +247,12 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     if (targets.rows()) targets = transform_points(to_projector.inverse(), targets);
   }
   r.supine_to_model = T;
-  for (const auto& rep : r.reports) r.converged = r.converged && rep.converged;
+  for (const auto& rep : r.reports) {
+    r.converged = r.converged && rep.converged;
+    if (rep.inverted > 0)
+      r.warnings.push_back(rep.name + " step: " + std::to_string(rep.inverted) + " tetrahedra ended inverted" +
+                           (rep.inversions_allowed ? " (the line search stalled on the inversion rule and was let invert)" : ""));
+  }
   r.seconds = since(t_start);
 
   // Outputs in the supine frame and figures of merit.

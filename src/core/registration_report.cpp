@@ -68,6 +68,7 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
       << ", \"energy_J\": " << num(s.energy) << ", \"gradient_norm_N\": " << num(s.gradient_norm)
       << ", \"projection_rms_change_mm\": " << num(s.projection_rms_change * 1e3)
       << ", \"constrained_skin_vertices\": " << s.constrained_skin << ", \"skin_vertices\": " << s.skin_vertices
+      << ", \"inverted_tetrahedra\": " << s.inverted << ", \"inversions_allowed\": " << (s.inversions_allowed ? "true" : "false")
       << ",\n     \"profile_seconds\": {\"setup\": "
       << num(s.t_setup) << ", \"assembly\": " << num(s.t_assembly) << ", \"factorization\": " << num(s.t_factorization)
       << ", \"solve\": " << num(s.t_solve) << ", \"line_search\": " << num(s.t_line_search)

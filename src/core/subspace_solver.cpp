@@ -48,6 +48,8 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
   Points x_trial(x.rows(), 3);
   Eigen::LDLT<Eigen::MatrixXd> ldlt;
   bool have_factor = false;
+  NewtonOptions local = opt;  // a stall may relax the inversion rule for the rest of the solve
+  InversionGuard guard;
   bool fresh_factor = false;  // the last direction stalled on the lagged factor: refactorize
   for (int it = 1; it <= opt.max_iterations; ++it) {
     IterationInfo info;
@@ -109,9 +111,10 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     H.scatter_add(U * d, 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
     info.t_solve += since(t0);
-    const StepOutcome outcome = apply_newton_step(energy, tets, opt, dx, gr.dot(d), x, x_trial, E, n_inv, info, res);
+    const StepOutcome outcome = apply_newton_step(energy, tets, local, dx, gr.dot(d), x, x_trial, E, n_inv, info, res);
     if (outcome != StepOutcome::Taken) {
-      if (!recover_from_stall(outcome, !info.factorized, res)) break;
+      if (!recover_from_stall(outcome, !info.factorized, local, res)) break;
+      guard.arm(res, x, E, n_inv);
       fresh_factor = true;
       continue;
     }
@@ -121,10 +124,13 @@ NewtonResult solve_subspace_newton(const TotalEnergy& energy, HessianAssembler& 
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
     if (info.step_norm <= opt.step_tolerance) {  // accepted, but too short to make progress
-      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, res)) break;
+      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, local, res)) break;
+      guard.arm(res, x, E, n_inv);
       fresh_factor = true;
     }
   }
+  if (guard.restore_if_worse(x, E, n_inv, res, tets.rows(), opt.max_inverted_fraction_after_stall))
+    gr = Ut * H.gather(energy.gradient(x));
   res.energy = E;
   res.gradient_norm = gr.norm();
   res.inverted = n_inv;

@@ -116,7 +116,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.stop_reason = to_string(r.reason);
     finished = true;
     if (r.reason == StopReason::Aborted) break;
-    if (r.reason == StopReason::Stalled || r.reason == StopReason::LineSearchFailed) {
+    if (r.reason == StopReason::Stalled || r.reason == StopReason::LineSearchFailed ||
+        r.reason == StopReason::InvertedAfterStall) {
       rep.stop_reason = "Newton " + rep.stop_reason + " (gradient " + std::to_string(r.gradient_norm) + " N)";
       break;
     }

@@ -116,19 +116,25 @@ TEST(NewtonSolver, NonFiniteStartIsAClearError) {
   btr::test::expect_throw_with<SolverError>([&] { solver.solve(energy, x, NewtonOptions{}); }, "not finite");
 }
 
-// A stall is never convergence: a lagged direction is retried on a fresh factor, an exact
-// Newton step below the step tolerance is convergence, a damped one is a stall.
+// A stall is never convergence: a lagged direction is retried on a fresh factor, then a
+// line search that refused inversions may invert, then it is a stall; an exact Newton step
+// below the step tolerance is convergence.
 TEST(NewtonSolver, StallsAreRetriedThenReportedAsStalls) {
   NewtonResult r;
-  EXPECT_TRUE(recover_from_stall(StepOutcome::Stalled, true, r));
-  EXPECT_TRUE(recover_from_stall(StepOutcome::NoDecrease, true, r));
-  EXPECT_FALSE(recover_from_stall(StepOutcome::Stalled, false, r));
+  NewtonOptions o;
+  ASSERT_TRUE(o.forbid_new_inversions);
+  EXPECT_TRUE(recover_from_stall(StepOutcome::Stalled, true, o, r));
+  EXPECT_TRUE(o.forbid_new_inversions);  // a fresh factor first
+  EXPECT_TRUE(recover_from_stall(StepOutcome::NoDecrease, false, o, r));
+  EXPECT_FALSE(o.forbid_new_inversions);
+  EXPECT_TRUE(r.inversions_allowed);
+  EXPECT_FALSE(recover_from_stall(StepOutcome::Stalled, false, o, r));
   EXPECT_FALSE(r.converged);
   EXPECT_EQ(r.reason, StopReason::Stalled);
-  EXPECT_FALSE(recover_from_stall(StepOutcome::NoDecrease, false, r));
+  EXPECT_FALSE(recover_from_stall(StepOutcome::NoDecrease, false, o, r));
   EXPECT_FALSE(r.converged);
   EXPECT_EQ(r.reason, StopReason::LineSearchFailed);
-  EXPECT_FALSE(recover_from_stall(StepOutcome::TooSmall, false, r));
+  EXPECT_FALSE(recover_from_stall(StepOutcome::TooSmall, false, o, r));
   EXPECT_TRUE(r.converged);
   EXPECT_EQ(r.reason, StopReason::StepTolerance);
 }

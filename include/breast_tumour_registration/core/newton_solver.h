@@ -18,6 +18,8 @@ enum class StopReason {
   StepTolerance,      ///< the full Newton step of a fresh factorization is below step_tolerance (converged:
                       ///< the minimum of the Newton model is that close; the gradient is at round-off)
   Stalled,            ///< damped line-search steps below step_tolerance while the full step is not (not converged)
+  InvertedAfterStall, ///< a stall let the line search invert elements and the solve ended with too many
+                      ///< inverted: the uninverted stall state is kept (not converged)
   MaxIterations,      ///< iteration cap reached (not converged)
   LineSearchFailed,   ///< no step decreased the energy even on a fresh factorization; state is the best found
   Aborted,            ///< the callback asked to stop
@@ -64,6 +66,11 @@ struct NewtonOptions {
   double max_forcing = 0.1;
   /// Reject line-search steps that invert more tetrahedra than the current state has.
   bool forbid_new_inversions = true;
+  /// When a stall lets the line search invert (recover_from_stall), the solve may end with at
+  /// most this fraction of the tetrahedra newly inverted (a few elements passing a nearly flat
+  /// state, reported); more means the mesh folded to meet its constraints, and the last
+  /// uninverted state is kept (StopReason::InvertedAfterStall).
+  double max_inverted_fraction_after_stall = 0.002;
   /// Called after every accepted iteration; return false to abort.
   std::function<bool(const IterationInfo&)> callback;
 };
@@ -80,6 +87,7 @@ struct NewtonResult {
   int regularizations = 0;  ///< factorizations that needed a diagonal shift
   int factorizations = 0;    ///< numeric Cholesky factorizations
   int pcg_iterations = 0;    ///< total preconditioned CG iterations (lagged-factor steps)
+  bool inversions_allowed = false;  ///< a stall made the line search accept new inversions
   std::vector<IterationInfo> history;
 };
 
@@ -94,11 +102,33 @@ bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, doubl
 /// accepted a step, but one below step_tolerance while the full step is not.
 enum class StepOutcome { Taken, TooSmall, NoDecrease, Stalled };
 
-/// After a direction that did not make progress (TooSmall, NoDecrease, Stalled): true when
-/// the direction came from the lagged factor, so the caller should retry the iteration on a
-/// fresh factorization (what a stall calls for first); otherwise sets the final reason in res
-/// (StepTolerance, converged; LineSearchFailed or Stalled, not converged) and returns false.
-bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonResult& res);
+/// After a direction that did not make progress (TooSmall, NoDecrease, Stalled), what a stall
+/// calls for, in order: a direction from the lagged factor is retried on a fresh
+/// factorization; then a line search that refused new inversions may invert elements (the
+/// stable Neo-Hookean energy is defined there; opt.forbid_new_inversions is cleared and
+/// res.inversions_allowed set). Returns true when the caller should retry (refactorizing);
+/// otherwise sets the final reason in res (StepTolerance, converged; LineSearchFailed or
+/// Stalled, not converged) and returns false.
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res);
+
+/// The state at which a stall let the line search invert elements (recover_from_stall). A solve
+/// that then ends with more than max_inverted_fraction_after_stall of its tetrahedra newly
+/// inverted folded the mesh to meet its constraints (landmarks pulled through the chest
+/// wall): the state is restored and the solve reported as InvertedAfterStall. One that ends
+/// within it keeps its result, and the count is reported (soft tissue whose prone shape
+/// stands in for the rest shape: 1 to 6 of 7.1k elements at E = 400 Pa).
+struct InversionGuard {
+  bool armed = false;
+  Points x;
+  double energy = 0;
+  long inverted = 0;
+  /// Records the state the first time res.inversions_allowed is set.
+  void arm(const NewtonResult& res, const Points& x_now, double E, long n_inv);
+  /// At the end of a solve: restores the recorded state when x has more than
+  /// max_fraction x n_tets inversions beyond it; returns true when it did (x, E, n_inv and res
+  /// updated; the caller recomputes |g|).
+  bool restore_if_worse(Points& x_now, double& E, long& n_inv, NewtonResult& res, long n_tets, double max_fraction) const;
+};
 
 /// Shared by the full-space and subspace solvers: takes the step dx (#V by 3) with the line
 /// search from x (energy E, n_inv inverted tetrahedra), updating x, E, n_inv, the iteration's

@@ -74,8 +74,12 @@ struct StepReport {
   /// surface projections; with the number of factorizations and PCG iterations.
   double t_setup = 0, t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0, t_projection = 0;
   int factorizations = 0, pcg_iterations = 0;
-  /// Adds a Newton solve's time split and counts.
+  long inverted = 0;                ///< inverted tetrahedra at the end of the step
+  bool inversions_allowed = false;  ///< a stall made the line search accept new inversions
+  /// Adds a Newton solve's time split and counts (and its inversion state: the latest).
   void add_newton_profile(const NewtonResult& r) {
+    inverted = r.inverted;
+    inversions_allowed = inversions_allowed || r.inversions_allowed;
     t_assembly += r.t_assembly;
     t_factorization += r.t_factorization;
     t_solve += r.t_solve;
