@@ -95,7 +95,7 @@ def runs(rows):
 def describe(sel):
     values = dist(sel)
     failed = runs([r for r in sel if not ok(r)])
-    not_converged = runs([r for r in sel if r["status"] == "not_converged"])
+    not_converged = runs([r for r in sel if r["status"].startswith("not_converged")])
     if not values:
         return "-", f"{failed} of {runs(sel)} runs failed"
     med = statistics.median(values)

@@ -256,13 +256,19 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           RegistrationOptions ro = preset;
           ro.landmark.weight = run->landmark_weight;
           const RegistrationResult r = run_registration(scene, rm, ro);
+          std::string status = "converged";
+          if (!r.converged) {  // which step, and why: a cap, a stall or a failed line search
+            status = "not_converged";
+            for (const auto& rep : r.reports)
+              if (!rep.converged) status += ": " + rep.name + ": " + rep.stop_reason;
+          }
           for (const auto& t : r.tumours) {
             row.tumour = t.name;
             row.centroid_distance_mm = t.centroid_distance * 1e3;
             row.hausdorff_mm = t.hausdorff * 1e3;
             row.volume_ratio = t.volume_ratio_to_truth;
             row.seconds = r.seconds;
-            row.status = r.converged ? "converged" : "not_converged";
+            row.status = status;
             rows.push_back(row);
           }
         } catch (const std::exception& err) {

@@ -59,7 +59,7 @@ struct ExperimentRow {
   double generating_youngs_modulus = 0;
   std::string tumour;
   double centroid_distance_mm = 0, hausdorff_mm = 0, volume_ratio = 0, seconds = 0;
-  std::string status;  ///< converged, not_converged, or failed: message
+  std::string status;  ///< converged, "not_converged: step: reason ...", or "failed: message"
 };
 
 /// CSV header and row writers (one row per run and tumour).
