@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <fstream>
+#include <algorithm>
+#include <limits>
 #include <sstream>
 
 #include "breast_tumour_registration/core/errors.h"
@@ -20,11 +22,13 @@ std::vector<std::string> split_fields(std::string line) {
   return out;
 }
 
+// An index: a whole number that fits an int (indices of 2^31 and above used to wrap to valid
+// vertices through a narrowing cast).
 bool parse_int(const std::string& s, long& v) {
   try {
     size_t used = 0;
     v = std::stol(s, &used);
-    return used == s.size();
+    return used == s.size() && v <= std::numeric_limits<int>::max() && v >= std::numeric_limits<int>::min();
   } catch (const std::logic_error&) {
     return false;
   }
@@ -53,7 +57,7 @@ std::vector<int> read_index_list(const std::string& path) {
     for (const auto& f : split_fields(line)) {
       long v = 0;
       if (!parse_int(f, v))
-        throw InputError(path + ":" + std::to_string(ln) + ": '" + f + "' is not a vertex index");
+        throw InputError(path + ":" + std::to_string(ln) + ": '" + f + "' is not a vertex index (0 to 2^31 - 1)");
       if (v < 0) throw InputError(path + ":" + std::to_string(ln) + ": negative vertex index " + f);
       out.push_back(static_cast<int>(v));
     }
@@ -103,15 +107,23 @@ std::vector<LandmarkPair> read_landmark_pairs(const std::string& path, LengthUni
   std::vector<LandmarkPair> out;
   std::string line;
   size_t ln = 0;
+  bool header_seen = false;
   while (std::getline(in, line)) {
     ++ln;
     const auto f = split_fields(line);
     if (f.empty()) continue;
     long a = 0;
     if (!parse_int(f[0], a)) {
-      if (out.empty()) continue;  // header
-      throw InputError(path + ":" + std::to_string(ln) + ": '" + f[0] + "' is not a prone vertex index");
+      // A header is the first line, and none of its fields is a number: a malformed first
+      // row is an error, not a header.
+      double dummy = 0;
+      const bool header = out.empty() && !header_seen &&
+                          std::none_of(f.begin(), f.end(), [&](const std::string& x) { return parse_real(x, dummy); });
+      header_seen = true;
+      if (header) continue;
+      throw InputError(path + ":" + std::to_string(ln) + ": '" + f[0] + "' is not a prone vertex index (0 to 2^31 - 1)");
     }
+    header_seen = true;
     if (a < 0) throw InputError(path + ":" + std::to_string(ln) + ": negative prone vertex index");
     LandmarkPair p;
     p.prone_vertex = static_cast<int>(a);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -55,6 +56,9 @@ long parse_long(const std::string& tok, const std::string& path, size_t line) {
     size_t used = 0;
     long v = std::stol(tok, &used);
     if (used != tok.size()) fail(path, line, "cannot parse integer '" + tok + "'");
+    // Counts and indices are ints inside: a larger value must not wrap to a valid one.
+    if (v > std::numeric_limits<int>::max() || v < std::numeric_limits<int>::min())
+      fail(path, line, "integer '" + tok + "' is out of range (at most 2^31 - 1)");
     return v;
   } catch (const std::logic_error&) {
     fail(path, line, "cannot parse integer '" + tok + "'");
@@ -89,6 +93,7 @@ class TokenStream {
     last_line_ = ln;
   }
   bool done() const { return pos_ >= tokens_.size(); }
+  size_t remaining() const { return tokens_.size() - pos_; }
   const Token& peek() const { return tokens_[pos_]; }
   const Token& next(const char* what) {
     if (done()) fail(path_, last_line_, std::string("unexpected end of file, expected ") + what);
@@ -101,6 +106,19 @@ class TokenStream {
   double next_double(const char* what) {
     const Token& t = next(what);
     return parse_double(t.text, path_, t.line);
+  }
+  /// A count from a header, checked against what the file holds before anything is allocated:
+  /// each item needs at least tokens_per_item more values.
+  long next_count(const char* what, long tokens_per_item) {
+    const Token& t = next(what);
+    const long n = parse_long(t.text, path_, t.line);
+    if (n < 0) fail(path_, t.line, std::string(what) + " " + t.text + " is negative");
+    const size_t left = tokens_.size() - pos_;
+    if (static_cast<unsigned long>(n) * static_cast<unsigned long>(tokens_per_item) > left)
+      fail(path_, t.line, std::string(what) + " " + t.text + " needs at least " +
+                              std::to_string(static_cast<unsigned long>(n) * tokens_per_item) + " values, the file holds " +
+                              std::to_string(left) + " more");
+    return n;
   }
   /// Skips the remaining tokens of `line`.
   void skip_rest_of_line(size_t line) {
@@ -191,10 +209,12 @@ SurfaceMesh read_off(const std::string& path, double scale, bool require_faces) 
   TokenStream ts(path, true);
   if (ts.done() || lower(ts.peek().text).find("off") == std::string::npos) throw InputError(path + ": missing OFF header");
   ts.next("header");
-  const long nv = ts.next_long("vertex count");
-  const long nf = ts.next_long("face count");
+  const long nv = ts.next_count("vertex count", 0);
+  const long nf = ts.next_count("face count", 0);
   ts.next("edge count");
-  if (nv < 0 || nf < 0) throw InputError(path + ": negative element count");
+  if (static_cast<unsigned long>(nv) * 3 + static_cast<unsigned long>(nf) * 4 > ts.remaining())
+    throw InputError(path + ": the header says " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+                     " faces, more than the file holds");
   std::vector<Vec3> verts;
   verts.reserve(nv);
   for (long i = 0; i < nv; ++i) {
@@ -366,7 +386,12 @@ SurfaceMesh read_ply(const std::string& path, double scale, bool require_faces) 
     std::string tag;
     ls >> tag;
     if (tag == "format") ls >> format;
-    else if (tag == "element") { PlyElement e; ls >> e.name >> e.count; elems.push_back(e); }
+    else if (tag == "element") {
+      PlyElement e;
+      if (!(ls >> e.name >> e.count) || e.count < 0 || e.count > static_cast<long>(content.size()))
+        throw InputError(path + ": PLY element '" + e.name + "' has a bad count (negative, or more than the file can hold)");
+      elems.push_back(e);
+    }
     else if (tag == "property") {
       if (elems.empty()) throw InputError(path + ": PLY property before any element");
       PlyProperty pr;
@@ -400,9 +425,15 @@ SurfaceMesh read_ply(const std::string& path, double scale, bool require_faces) 
       std::vector<int> poly;
       for (const auto& pr : e.props) {
         if (!pr.count_type.empty()) {
-          const long n = static_cast<long>(read_value(pr.count_type));
+          const double n = read_value(pr.count_type);
+          if (!(n >= 0 && n <= 1e6)) throw InputError(path + ": PLY list count " + std::to_string(n) + " out of range");
           std::vector<int> vals;
-          for (long j = 0; j < n; ++j) vals.push_back(static_cast<int>(read_value(pr.type)));
+          for (long j = 0; j < static_cast<long>(n); ++j) {
+            const double x = read_value(pr.type);
+            if (!(x >= 0 && x <= std::numeric_limits<int>::max()) || x != std::floor(x))
+              throw InputError(path + ": PLY index " + std::to_string(x) + " is not an index (0 to 2^31 - 1)");
+            vals.push_back(static_cast<int>(x));
+          }
           if (e.name == "face" && (pr.name == "vertex_indices" || pr.name == "vertex_index")) poly = vals;
         } else {
           const double x = read_value(pr.type);
@@ -451,14 +482,14 @@ TetMesh read_vtk(const std::string& path, double scale) {
     } else if (kw == "binary") {
       fail(path, tok.line, "binary legacy VTK is not supported; save as ASCII");
     } else if (kw == "points") {
-      const long n = ts.next_long("point count");
+      const long n = ts.next_count("point count", 3);
       ts.next("point type");
       verts.resize(n);
       for (long i = 0; i < n; ++i)
         for (int c = 0; c < 3; ++c) verts[i][c] = ts.next_double("coordinate");
       have_points = true;
     } else if (kw == "cells") {
-      const long n = ts.next_long("cell count");
+      const long n = ts.next_count("cell count", 2);
       ts.next("cell list size");
       cells.resize(n);
       for (long i = 0; i < n; ++i) {
@@ -467,7 +498,7 @@ TetMesh read_vtk(const std::string& path, double scale) {
       }
       have_cells = true;
     } else if (kw == "cell_types") {
-      const long n = ts.next_long("cell type count");
+      const long n = ts.next_count("cell type count", 1);
       for (long i = 0; i < n; ++i) types.push_back(static_cast<int>(ts.next_long("cell type")));
     } else if (kw == "point_data" || kw == "cell_data") {
       break;  // attributes are not needed
@@ -524,7 +555,7 @@ TetMesh read_medit(const std::string& path, double scale) {
       const auto t = ts.next("value");
       if (kw == "dimension" && t.text != "3") fail(path, t.line, "only Dimension 3 is supported");
     } else if (kw == "vertices") {
-      const long n = ts.next_long("vertex count");
+      const long n = ts.next_count("vertex count", 4);
       verts.resize(n);
       for (long i = 0; i < n; ++i) {
         for (int c = 0; c < 3; ++c) verts[i][c] = ts.next_double("coordinate");
@@ -532,7 +563,7 @@ TetMesh read_medit(const std::string& path, double scale) {
       }
       have_v = true;
     } else if (kw == "tetrahedra") {
-      const long n = ts.next_long("tetrahedron count");
+      const long n = ts.next_count("tetrahedron count", 5);
       for (long i = 0; i < n; ++i) {
         Eigen::Vector4i t;
         for (int c = 0; c < 4; ++c) t[c] = static_cast<int>(ts.next_long("tetrahedron index")) - 1;  // 1-based

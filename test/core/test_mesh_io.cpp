@@ -122,7 +122,9 @@ TEST(MeshIoErrors, UnknownFormatAndNonTetCells) {
              "0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1\nCELLS 1 9\n8 0 1 2 3 4 5 6 7\nCELL_TYPES 1\n12\n");
   expect_throw_with<InputError>([&] { read_tet_mesh(dir + "/hex.vtk", LengthUnit::Metre); }, "only tetrahedra");
   write_text(dir + "/trunc.mesh", "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n");
-  expect_throw_with<InputError>([&] { read_tet_mesh(dir + "/trunc.mesh", LengthUnit::Metre); }, "unexpected end of file");
+  // Refused at the count, before the vertices are read (issue 11: counts are checked first).
+  expect_throw_with<InputError>([&] { read_tet_mesh(dir + "/trunc.mesh", LengthUnit::Metre); },
+                                "trunc.mesh:4: vertex count 4 needs at least 16 values, the file holds 8 more");
 }
 
 TEST(IndexIo, IndexListAcceptsCommasWhitespaceAndComments) {
@@ -163,4 +165,30 @@ TEST(PointCloudIo, VertexOnlyPlyAndObjAreCloudsButNotSurfaces) {
   ASSERT_EQ(b.rows(), 2);
   EXPECT_DOUBLE_EQ(b(1, 0), 4.0);
   expect_throw_with<InputError>([&] { read_surface(dir + "/pts.obj", LengthUnit::Millimetre); }, "no faces");
+}
+
+// Issue 11: indices of 2^31 and above no longer wrap to valid vertices, a header's counts are
+// checked against what the file holds before anything is allocated, and a malformed first
+// landmark row is an error instead of a skipped header.
+TEST(MeshIoErrors, HostileCountsAndIndicesAreRefusedBeforeAllocating) {
+  const std::string dir = btr::test::temp_dir();
+  btr::test::write_text(dir + "/wrap.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967299\n");
+  expect_throw_with<InputError>([&] { read_surface(dir + "/wrap.obj", LengthUnit::Metre); }, "out of range (at most 2^31 - 1)");
+  btr::test::write_text(dir + "/huge.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                                            "POINTS 4 double\n0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 200000000 1000000000\n4 0 1 2 3\n");
+  expect_throw_with<InputError>([&] { read_tet_mesh(dir + "/huge.vtk", LengthUnit::Metre); },
+                                "cell count 200000000 needs at least 400000000 values, the file holds");
+  btr::test::write_text(dir + "/negative.vtk", "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS -5 double\n");
+  expect_throw_with<InputError>([&] { read_tet_mesh(dir + "/negative.vtk", LengthUnit::Metre); }, "point count -5 is negative");
+  btr::test::write_text(dir + "/huge.off", "OFF\n100000000 1 0\n0 0 0\n");
+  expect_throw_with<InputError>([&] { read_surface(dir + "/huge.off", LengthUnit::Metre); }, "more than the file holds");
+  btr::test::write_text(dir + "/wrap.txt", "1 2 4294967296\n");
+  expect_throw_with<InputError>([&] { read_index_list(dir + "/wrap.txt"); }, "is not a vertex index (0 to 2^31 - 1)");
+  btr::test::write_text(dir + "/wrap.csv", "prone_index,x,y,z\n4294967296,1,2,3\n");
+  expect_throw_with<InputError>([&] { read_landmark_pairs(dir + "/wrap.csv", LengthUnit::Metre); }, "is not a prone vertex index");
+  btr::test::write_text(dir + "/first_row.csv", "12a,1,2,3\n5,1,2,3\n");
+  expect_throw_with<InputError>([&] { read_landmark_pairs(dir + "/first_row.csv", LengthUnit::Metre); },
+                                "first_row.csv:1: '12a' is not a prone vertex index");
+  btr::test::write_text(dir + "/header.csv", "prone_index,x,y,z\n5,1,2,3\n");
+  EXPECT_EQ(read_landmark_pairs(dir + "/header.csv", LengthUnit::Metre).size(), 1u);
 }
