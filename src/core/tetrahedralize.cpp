@@ -48,7 +48,11 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   Criteria criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
                     p::facet_distance = opt.facet_distance_ratio * h,
                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = h);
-  C3t3 c3t3 = opt.optimize ? CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_lloyd(), p::no_odt(), p::perturb(), p::exude())
+  // The optimisers' time limits default to the measured refinement time, which made one input
+  // give several meshes (issue 11); without a limit they stop on their own criteria, and the
+  // domain's random generator is seeded (Random(0)), so one input gives one mesh.
+  C3t3 c3t3 = opt.optimize ? CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_lloyd(), p::no_odt(),
+                                                     p::perturb(p::time_limit = 0.0), p::exude(p::time_limit = 0.0))
                            : CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_lloyd(), p::no_odt(), p::no_perturb(), p::no_exude());
 
   TetMesh out;

@@ -86,3 +86,16 @@ TEST(Tetrahedralize, ChestWallVerticesSurviveAsTheFlatBase) {
   btr::test::expect_throw_with<InputError>([&] { boundary_vertices_near_region(m, s, {0, 1}, 1e-9); },
                                            "contains no complete face");
 }
+
+// Issue 11: one input, one mesh. CGAL bounded its optimisers by the measured refinement time,
+// so the same surface gave different meshes from run to run (10 640 to 10 647 tets).
+TEST(Tetrahedralize, TheSameInputGivesTheSameMeshBitForBit) {
+  const SurfaceMesh s = make_icosphere(Vec3(0.0, 0.01, 0.02), 0.06, 4);
+  TetrahedralizeOptions opt;
+  opt.cell_size = 0.007;
+  const TetMesh a = tetrahedralize(s, opt), b = tetrahedralize(s, opt);
+  ASSERT_EQ(a.T.rows(), b.T.rows());
+  ASSERT_EQ(a.V.rows(), b.V.rows());
+  EXPECT_TRUE(a.T == b.T);
+  EXPECT_TRUE(a.V == b.V);  // bit-identical coordinates
+}
