@@ -18,12 +18,25 @@ CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan) {
     if (field.name == "z") f[2] = &field;
   }
   if (!f[0] || !f[1] || !f[2]) throw InputError("point cloud has no x, y, z fields");
-  for (const auto* p : f)
+  // Every read below stays inside msg.data: the layout is checked in 64-bit arithmetic first
+  // (a malformed cloud from any publisher must not crash the node).
+  const uint64_t point_step = msg.point_step, row_step = msg.row_step, width = msg.width, height = msg.height;
+  for (const auto* p : f) {
     if (p->datatype != sensor_msgs::PointField::FLOAT32 && p->datatype != sensor_msgs::PointField::FLOAT64)
       throw InputError("point cloud field '" + p->name + "' is not FLOAT32 or FLOAT64");
-  const size_t n = static_cast<size_t>(msg.width) * msg.height;
-  if (msg.point_step == 0 || msg.data.size() < n * msg.point_step || msg.row_step < msg.width * msg.point_step)
-    throw InputError("point cloud data size does not match width x height x point_step");
+    const uint64_t size = p->datatype == sensor_msgs::PointField::FLOAT32 ? 4 : 8;
+    if (p->count < 1 || uint64_t{p->offset} + size > point_step)
+      throw InputError("point cloud field '" + p->name + "' (offset " + std::to_string(p->offset) +
+                       ") does not fit in a point of " + std::to_string(point_step) + " bytes");
+  }
+  if (msg.is_bigendian) throw InputError("big-endian point clouds are not supported");
+  if (width * point_step > row_step)
+    throw InputError("point cloud row_step " + std::to_string(row_step) + " is shorter than width x point_step (" +
+                     std::to_string(width * point_step) + ")");
+  if (width > 0 && height > 0 && (height - 1) * row_step + width * point_step > msg.data.size())
+    throw InputError("point cloud data (" + std::to_string(msg.data.size()) + " bytes) is shorter than its layout (" +
+                     std::to_string(height) + " rows of " + std::to_string(row_step) + " bytes)");
+  const size_t n = static_cast<size_t>(width * height);
   CloudPoints out;
   out.width = static_cast<int>(msg.width);
   out.height = static_cast<int>(msg.height);

@@ -54,6 +54,48 @@ TEST(Converters, Float64FieldsAndMalformedClouds) {
   EXPECT_THROW(ros_conv::from_cloud(truncated, false), InputError);
 }
 
+// Issue 11: clouds whose layout points outside their data used to be read unchecked (SIGSEGV
+// in the node). Each is now an InputError that says what is wrong.
+TEST(Converters, LayoutsThatPointOutsideTheDataAreRefused) {
+  sensor_msgs::PointCloud2 msg;
+  sensor_msgs::PointCloud2Modifier mod(msg);
+  mod.setPointCloud2FieldsByString(1, "xyz");
+  mod.resize(100);
+  msg.width = 10;
+  msg.height = 10;
+  msg.row_step = msg.width * msg.point_step;
+  ASSERT_NO_THROW(ros_conv::from_cloud(msg, true));
+  auto expect_refused = [](const sensor_msgs::PointCloud2& m, const std::string& what) {
+    try {
+      ros_conv::from_cloud(m, true);
+      ADD_FAILURE() << "accepted a cloud that should be refused: " << what;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  sensor_msgs::PointCloud2 far_z = msg;
+  far_z.fields[2].offset = 1000000000u;
+  expect_refused(far_z, "field 'z' (offset 1000000000) does not fit");
+  sensor_msgs::PointCloud2 long_rows = msg;
+  long_rows.row_step = 100000000u;
+  long_rows.data.resize(1200);
+  expect_refused(long_rows, "is shorter than its layout");
+  sensor_msgs::PointCloud2 short_rows = msg;
+  short_rows.row_step = msg.point_step * 5;
+  expect_refused(short_rows, "row_step");
+  sensor_msgs::PointCloud2 big_endian = msg;
+  big_endian.is_bigendian = true;
+  expect_refused(big_endian, "big-endian");
+  sensor_msgs::PointCloud2 huge = msg;  // width x height far beyond the data: refused before allocating
+  huge.width = 4000000000u;
+  huge.height = 4000000000u;
+  huge.row_step = huge.width * 16ull > 0xffffffffull ? 0xffffffffu : huge.width * 16u;
+  expect_refused(huge, "shorter than");
+  sensor_msgs::PointCloud2 no_count = msg;
+  no_count.fields[0].count = 0;
+  expect_refused(no_count, "field 'x'");
+}
+
 TEST(Converters, MeshMarkerAndTransformRoundTrips) {
   const SurfaceMesh s = make_icosphere(Vec3(0.1, 0.2, 0.3), 0.01, 1);
   const shape_msgs::Mesh m = ros_conv::to_mesh(s);

@@ -86,9 +86,18 @@ TEST(RegistrationNode, BadCloudsAreRejectedAndTheNodeKeepsAnswering) {
     sensor_msgs::PointCloud2 msg;
     std::string expected;
   };
+  // Issue 11: the two layouts that used to crash the node (SIGSEGV); the bag test after this
+  // one shows it still registers.
+  sensor_msgs::PointCloud2 far_z = btr::ros_conv::to_cloud(fine, 4, 3, "world");
+  far_z.fields[2].offset = 1000000000u;
+  sensor_msgs::PointCloud2 long_rows = btr::ros_conv::to_cloud(btr::Points::Random(100, 3), 10, 10, "world");
+  long_rows.row_step = 100000000u;
+  long_rows.data.resize(1200);
   std::vector<Case> cases = {{btr::ros_conv::to_cloud(empty, 0, 1, "world"), "empty point cloud"},
                              {btr::ros_conv::to_cloud(all_nan, 4, 3, "world"), "all NaN"},
-                             {btr::ros_conv::to_cloud(fine, 4, 3, "no_such_frame"), "no transform"}};
+                             {btr::ros_conv::to_cloud(fine, 4, 3, "no_such_frame"), "no transform"},
+                             {far_z, "does not fit"},
+                             {long_rows, "shorter than its layout"}};
   for (auto& c : cases) {
     c.msg.header.stamp = ros::Time::now();
     pubs().cloud.publish(c.msg);
