@@ -97,6 +97,19 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   return j.str();
 }
 
+void prepare_output_folder(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) throw InputError("--out '" + dir + "': cannot create the output folder (" + ec.message() + ")");
+  const fs::path probe = fs::path(dir) / ".btr_write_test";
+  {
+    std::ofstream out(probe);
+    if (!out || !(out << "x")) throw InputError("--out '" + dir + "': the output folder is not writable");
+  }
+  fs::remove(probe, ec);
+}
+
 std::vector<std::string> write_registration_outputs(const std::string& dir, const Scene& scene,
                                                     const RegistrationModel& model, const RegistrationResult& r,
                                                     double prepare_seconds) {

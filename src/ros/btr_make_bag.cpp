@@ -2,6 +2,8 @@
 // writes a rosbag of organized PointCloud2 messages at 30 Hz with their tf, plus a truth
 // file (patient pose, ground-truth tumour centroids in the world frame) for evaluation.
 #include <CLI/CLI.hpp>
+
+#include "breast_tumour_registration/cli_checks.h"
 #include <rosbag/bag.h>
 #include <tf2_msgs/TFMessage.h>
 #include <yaml-cpp/yaml.h>
@@ -27,15 +29,15 @@ int main(int argc, char** argv) {
   std::vector<double> pose = {0.10, -0.05, 0.75, 0.0, 0.0, 20.0};
   app.add_option("scene", scene_path, "scene file (needs supine.surface; supine.chest_ring is rendered too)")->required();
   app.add_option("-o,--out", bag_path, "bag file")->capture_default_str();
-  app.add_option("--frames", frames, "number of clouds (30 Hz)")->capture_default_str();
-  app.add_option("--noise-mm", noise_mm, "depth noise sigma [mm]")->capture_default_str();
-  app.add_option("--width", width, "image width [px]")->capture_default_str();
-  app.add_option("--height", height, "image height [px]")->capture_default_str();
-  app.add_option("--distance", distance, "camera distance above the breast [m]")->capture_default_str();
+  app.add_option("--frames", frames, "number of clouds (30 Hz)")->capture_default_str()->check(CLI::Range(1, 1000000));
+  app.add_option("--noise-mm", noise_mm, "depth noise sigma [mm]")->capture_default_str()->check(btr::cli::non_negative());
+  app.add_option("--width", width, "image width [px]")->capture_default_str()->check(CLI::Range(8, 8192));
+  app.add_option("--height", height, "image height [px]")->capture_default_str()->check(CLI::Range(8, 8192));
+  app.add_option("--distance", distance, "camera distance above the breast [m]")->capture_default_str()->check(btr::cli::positive());
   app.add_option("--patient-pose", pose, "patient (model) frame in the world: x y z [m] roll pitch yaw [deg]")
       ->expected(6)->capture_default_str();
   app.add_option("--topic", topic, "cloud topic")->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     if (frames < 1) throw InputError("--frames must be >= 1");
     const Scene scene = load_scene(scene_path);

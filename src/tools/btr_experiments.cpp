@@ -3,6 +3,8 @@
 // comparison table with the thesis come from scripts/plot_experiments.py.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/cli_checks.h"
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -30,14 +32,15 @@ int main(int argc, char** argv) {
   app.add_option("-e,--experiments", experiments,
                  "experiments to run (default all): practical rest_shape rotated_gravity misalignment material "
                  "landmark_weight landmark_set");
-  app.add_option("-E,--youngs-moduli", moduli, "generating Young's moduli [Pa] (default: the thesis's 16, 200-12000)");
+  app.add_option("-E,--youngs-moduli", moduli, "generating Young's moduli [Pa] (default: the thesis's 16, 200-12000)")
+      ->check(btr::cli::positive());
   app.add_option("--model", model_path, "a rest model file (YAML, see rest_model_io.h) instead of the built-in phantom");
   app.add_option("--cell-size", cell_mm, "built-in phantom: tetrahedron size bound [mm] (8: ~6k tets, 4.7: ~35k)")
       ->capture_default_str();
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
   app.add_flag("--quick", quick, "a few values per experiment and two generating moduli (1000, 4000 Pa) unless -E");
   app.add_flag("-q,--quiet", quiet, "no progress lines");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   const auto t0 = std::chrono::steady_clock::now();
   try {

@@ -2,6 +2,8 @@
 // and supine configurations under gravity, and writes a scene that later steps can load.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/cli_checks.h"
+
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -26,19 +28,22 @@ int main(int argc, char** argv) {
   bool quiet = false;
   double tumour_E = 0;
   app.add_option("-o,--out", out_dir, "output folder (created)")->capture_default_str();
-  app.add_option("-E,--youngs-modulus", E, "Young's modulus used to generate prone and supine [Pa]")->capture_default_str();
+  app.add_option("-E,--youngs-modulus", E, "Young's modulus used to generate prone and supine [Pa]")->capture_default_str()
+      ->check(btr::cli::positive());
   app.add_option("--poisson-ratio", nu, "Poisson's ratio, in [0, 0.5)")->capture_default_str();
-  app.add_option("--density", rho, "density [kg/m^3]")->capture_default_str();
-  app.add_option("--cell-size", cell_mm, "tetrahedron size bound [mm] (8: ~6k tets, 4: ~35k)")->capture_default_str();
+  app.add_option("--density", rho, "density [kg/m^3]")->capture_default_str()->check(btr::cli::positive());
+  app.add_option("--cell-size", cell_mm, "tetrahedron size bound [mm] (8: ~6k tets, 4: ~35k)")->capture_default_str()
+      ->check(btr::cli::positive());
   app.add_option("--radius-edge-ratio", ratio, "tetrahedron quality bound (circumradius / shortest edge)")->capture_default_str();
   app.add_option("--tumour-radius", tumour_mm, "tumour sphere radius [mm]")->capture_default_str();
   app.add_option("--units", units, "length unit of the written files: mm or m")->capture_default_str();
   app.add_option("--landmarks", landmark_set, "landmark set: C+O, O+Oa+I, O+I, O+Oa, Oa+I, or names like C,O1,O2")
       ->capture_default_str();
   app.add_option("--tumour-youngs-modulus", tumour_E, "generate with stiff tumours of this Young's modulus [Pa] (0: homogeneous)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(btr::cli::non_negative());
   app.add_flag("-q,--quiet", quiet, "no per-iteration progress");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   const auto t0 = std::chrono::steady_clock::now();
   try {

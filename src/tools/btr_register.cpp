@@ -2,6 +2,8 @@
 // registered meshes, tumours, report.json and cross_section.png.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/cli_checks.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -26,17 +28,19 @@ int main(int argc, char** argv) {
   app.add_option("-o,--out", out_dir, "output folder (created)")->capture_default_str();
   app.add_option("-p,--preset", preset, "fast, balanced or accurate (default: the scene's, else balanced)");
   app.add_option("-s,--steps", steps, "override the scene's steps: auto, or a comma list of rigid,gravity,landmarks,surface");
-  app.add_option("--tumour-youngs-modulus", tumour_E, "give tumour elements this Young's modulus [Pa] (stiffer tumour)");
+  app.add_option("--tumour-youngs-modulus", tumour_E, "give tumour elements this Young's modulus [Pa] (stiffer tumour)")
+      ->check(btr::cli::positive());
   app.add_option("--cell-size", cell_mm,
                  "simulate on the prone model (re-)tetrahedralized at this cell size [mm] (default: a prone surface's "
                  "prone.cell_size_mm, else the preset's; 0: the scene's mesh as given)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(btr::cli::non_negative());
   app.add_flag("-q,--quiet", quiet, "no progress display");
-  CLI11_PARSE(app, argc, argv);
+  if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   const bool tty = isatty(fileno(stdout));
   try {
     auto t0 = std::chrono::steady_clock::now();
+    prepare_output_folder(out_dir);
     SceneLoadOptions load;
     load.tetrahedralize = false;  // a prone surface is meshed once, below, at the size the call simulates
     Scene scene = load_scene(scene_path, load);

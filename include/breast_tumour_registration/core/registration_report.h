@@ -12,6 +12,10 @@ namespace btr {
 std::string registration_report_json(const Scene& scene, const RegistrationModel& model, const RegistrationResult& r,
                                      double prepare_seconds);
 
+/// Creates `dir` and checks that it is writable, before any work (issue 11: an unwritable
+/// --out was found only after the whole registration). InputError naming --out otherwise.
+void prepare_output_folder(const std::string& dir);
+
 /// Writes every output into `dir` (created); returns the list of files written.
 std::vector<std::string> write_registration_outputs(const std::string& dir, const Scene& scene,
                                                     const RegistrationModel& model, const RegistrationResult& r,

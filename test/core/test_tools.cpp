@@ -1,0 +1,59 @@
+// The command-line tools as a user runs them: every input mistake exits with code 2 and a
+// message that names what is wrong (issues 10 and 11), before any expensive work.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <sys/wait.h>
+
+#include "test_util.h"
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string output;
+};
+
+Run run(const std::string& args) {
+  const std::string cmd = std::string(BTR_TOOLS_DIR) + "/" + args + " 2>&1";
+  Run r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf{};
+  size_t n = 0;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.output.append(buf.data(), n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+void expect_refused(const std::string& args, const std::string& needle) {
+  const Run r = run(args);
+  EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
+  EXPECT_NE(r.output.find(needle), std::string::npos) << args << "\n" << r.output;
+}
+
+}  // namespace
+
+TEST(Tools, NumbersThatAreNotFiniteOrOutOfRangeExitWithCode2) {
+  expect_refused("btr_register scene.yaml --cell-size nan", "is not finite");
+  expect_refused("btr_register scene.yaml --tumour-youngs-modulus -5", "must be a finite number > 0");
+  expect_refused("btr_experiments -E -100 --out /tmp/btr_no_experiment", "must be a finite number > 0");
+  expect_refused("btr_phantom --cell-size 0 --out /tmp/btr_no_phantom", "must be a finite number > 0");
+  expect_refused("btr_phantom --youngs-modulus inf --out /tmp/btr_no_phantom", "is not finite");
+  expect_refused("btr_register", "scene is required");
+}
+
+TEST(Tools, SceneMistakesAndAnUnwritableOutputExitWithCode2BeforeWork) {
+  const std::string d = btr::test::temp_dir();
+  btr::test::write_text(d + "/scene.yaml", "units: mm\ncell_size_mm: 5\n");
+  expect_refused("btr_register " + d + "/scene.yaml --out " + d + "/out", "unknown key (did you mean prone.cell_size_mm?)");
+  btr::test::write_text(d + "/typed.yaml", "units: [mm]\n");
+  expect_refused("btr_register " + d + "/typed.yaml --out " + d + "/out", "field 'units': expected a single value");
+  btr::test::write_text(d + "/blocker", "a file where a folder should be");
+  expect_refused("btr_register " + d + "/scene.yaml --out " + d + "/blocker/out", "--out '" + d + "/blocker/out'");
+  EXPECT_EQ(run("btr_register --help").code, 0);
+}
