@@ -24,9 +24,18 @@ struct NotReady : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A parameter that is set must have the right type: `~voxel_size: abc` used to fall back to
+/// the default without a word (issue 11).
+template <class T>
+void read_param(const ros::NodeHandle& pnh, const std::string& name, T& value, const char* type) {
+  if (!pnh.hasParam(name)) return;
+  if (!pnh.getParam(name, value)) throw InputError("parameter ~" + name + " has the wrong type (expected " + type + ")");
+}
+
 Vec3 read_vec3(const ros::NodeHandle& pnh, const std::string& name, const Vec3& def) {
   std::vector<double> v;
-  if (!pnh.getParam(name, v)) return def;
+  if (!pnh.hasParam(name)) return def;
+  if (!pnh.getParam(name, v)) throw InputError("parameter ~" + name + " has the wrong type (expected a list of 3 numbers)");
   if (v.size() != 3) throw InputError("parameter ~" + name + " must be a list of 3 numbers");
   return Vec3(v[0], v[1], v[2]);
 }
@@ -42,23 +51,25 @@ double thread_cpu_seconds() {
 
 NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   NodeParameters p;
-  pnh.param("scene", p.scene, p.scene);
-  pnh.param("working_frame", p.working_frame, p.working_frame);
-  pnh.param("model_frame", p.model_frame, p.model_frame);
-  pnh.param("preset", p.preset, p.preset);
-  pnh.param("voxel_size", p.voxel_size, p.voxel_size);
-  pnh.param("icp_every_n", p.icp_every_n, p.icp_every_n);
-  pnh.param("icp_max_iterations", p.icp_max_iterations, p.icp_max_iterations);
-  pnh.param("icp_max_correspondence", p.icp_max_correspondence, p.icp_max_correspondence);
-  pnh.param("max_depth_edge", p.max_depth_edge, p.max_depth_edge);
-  pnh.param("use_landmarks", p.use_landmarks, p.use_landmarks);
-  pnh.param("min_tracked_clouds", p.min_tracked_clouds, p.min_tracked_clouds);
-  pnh.param("rigid_margin", p.rigid_margin, p.rigid_margin);
-  pnh.param("smoothing_clouds", p.smoothing_clouds, p.smoothing_clouds);
+  read_param(pnh, "scene", p.scene, "a file name");
+  read_param(pnh, "working_frame", p.working_frame, "a frame name");
+  read_param(pnh, "model_frame", p.model_frame, "a frame name");
+  read_param(pnh, "preset", p.preset, "fast, balanced or accurate");
+  read_param(pnh, "voxel_size", p.voxel_size, "a number [m]");
+  read_param(pnh, "icp_every_n", p.icp_every_n, "an integer");
+  read_param(pnh, "icp_max_iterations", p.icp_max_iterations, "an integer");
+  read_param(pnh, "icp_max_correspondence", p.icp_max_correspondence, "a number [m]");
+  read_param(pnh, "max_depth_edge", p.max_depth_edge, "a number [m]");
+  read_param(pnh, "use_landmarks", p.use_landmarks, "true or false");
+  read_param(pnh, "min_tracked_clouds", p.min_tracked_clouds, "an integer");
+  read_param(pnh, "rigid_margin", p.rigid_margin, "a number [m]");
+  read_param(pnh, "smoothing_clouds", p.smoothing_clouds, "an integer");
   p.roi_min = read_vec3(pnh, "roi_min", p.roi_min);
   p.roi_max = read_vec3(pnh, "roi_max", p.roi_max);
   std::vector<double> pose;
-  if (pnh.getParam("initial_model_pose", pose)) {
+  if (pnh.hasParam("initial_model_pose") && !pnh.getParam("initial_model_pose", pose))
+    throw InputError("parameter ~initial_model_pose has the wrong type (expected [x, y, z, roll, pitch, yaw])");
+  if (!pose.empty()) {
     if (pose.size() != 6) throw InputError("parameter ~initial_model_pose must be [x, y, z, roll, pitch, yaw]");
     p.initial_model_pose = rigid_from_rpy(Vec3(pose[0], pose[1], pose[2]), Vec3(pose[3], pose[4], pose[5]));
   }

@@ -164,15 +164,18 @@ TEST(RegistrationNode, ReplayedBagGivesTheTumourWithinThreeMillimetresThePoseWit
   EXPECT_LT(trans, 0.5e-3);
 }
 
-// Run by bad_parameter.test only (node.test filters it out): a node started with a
-// parameter out of range keeps running and answers with the parameter's name.
+// Run by bad_parameter*.test only (node.test filters it out): a node started with a
+// parameter out of range, or of the wrong type, keeps running and answers with the
+// parameter's name (~expected: the text the answer must hold).
 TEST(RegistrationNodeBadParameter, KeepsRunningAndNamesTheParameter) {
   ASSERT_TRUE(ros::service::waitForService(kService, ros::Duration(60)));
+  std::string expected = "~smoothing_clouds";
+  ros::NodeHandle("~").getParam("expected", expected);
   for (int i = 0; i < 2; ++i) {
     const auto srv = call(false);
     EXPECT_FALSE(srv.response.success);
     EXPECT_NE(srv.response.message.find("invalid parameter"), std::string::npos) << srv.response.message;
-    EXPECT_NE(srv.response.message.find("~smoothing_clouds"), std::string::npos) << srv.response.message;
+    EXPECT_NE(srv.response.message.find(expected), std::string::npos) << srv.response.message;
     pubs().cloud.publish(sensor_msgs::PointCloud2());  // an empty cloud in between: still alive
     ros::WallDuration(0.2).sleep();
   }
