@@ -249,6 +249,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   r.supine_to_model = T;
   for (const auto& rep : r.reports) {
     r.converged = r.converged && rep.converged;
+    if (!rep.note.empty()) r.warnings.push_back(rep.name + " step: " + rep.note);
     if (rep.inverted > 0)
       r.warnings.push_back(rep.name + " step: " + std::to_string(rep.inverted) + " tetrahedra ended inverted" +
                            (rep.inversions_allowed ? " (the line search stalled on the inversion rule and was let invert)" : ""));

@@ -163,10 +163,19 @@ Scene load_scene_fields(const std::string& path) {
     if (s.supine_surface) c.fail("supine.cloud", "give supine.surface or supine.cloud, not both");
     s.supine_cloud = c.load("supine.cloud", [&] { return read_point_cloud(c.path_of(supine["cloud"], "supine.cloud"), s.units); });
   }
-  if (supine && supine["chest_ring"])
-    s.supine_rigid = c.load("supine.chest_ring", [&] { return read_surface(c.path_of(supine["chest_ring"], "supine.chest_ring"), s.units); });
-  if (root["chest_ring"])
-    s.prone_rigid = c.load("chest_ring", [&] { return read_surface(c.path_of(root["chest_ring"], "chest_ring"), s.units); });
+  // Rigid regions may be open; they are checked at load (a NaN used to surface only in ICP).
+  auto open_surface = [&](const YAML::Node& n, const std::string& field) {
+    return c.load(field, [&] {
+      SurfaceMesh m = read_surface(c.path_of(n, field), s.units);
+      SurfaceCheckOptions o;
+      o.require_closed = false;
+      o.require_consistent_orientation = false;
+      validate_surface(m, field, o);
+      return m;
+    });
+  };
+  if (supine && supine["chest_ring"]) s.supine_rigid = open_surface(supine["chest_ring"], "supine.chest_ring");
+  if (root["chest_ring"]) s.prone_rigid = open_surface(root["chest_ring"], "chest_ring");
 
   // Landmarks.
   if (root["landmarks"]) {
@@ -191,6 +200,30 @@ Scene load_scene_fields(const std::string& path) {
       else s.landmark_anchors.push_back(Anchor::vertex(p.prone_vertex));
     }
     if (s.prone_source) s.prone_source->landmarks = prone_pts;
+    // The same pair given twice adds nothing but cost: merged, with a warning.
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index i = 0; i < s.landmark_supine.rows(); ++i) {
+      bool dup = false;
+      for (Eigen::Index j : keep)
+        dup = dup || ((s.prone_source ? (prone_pts.row(i) - prone_pts.row(j)).norm() == 0
+                                      : s.landmark_anchors[i].v[0] == s.landmark_anchors[j].v[0]) &&
+                      (s.landmark_supine.row(i) - s.landmark_supine.row(j)).norm() == 0);
+      if (!dup) keep.push_back(i);
+    }
+    if (keep.size() < static_cast<size_t>(s.landmark_supine.rows())) {
+      s.warnings.push_back("landmarks: " + std::to_string(s.landmark_supine.rows() - static_cast<Eigen::Index>(keep.size())) +
+                           " duplicate pairs merged");
+      Points sup(keep.size(), 3), pro(keep.size(), 3);
+      std::vector<Anchor> anchors;
+      for (size_t k = 0; k < keep.size(); ++k) {
+        sup.row(k) = s.landmark_supine.row(keep[k]);
+        if (s.prone_source) pro.row(k) = prone_pts.row(keep[k]);
+        else anchors.push_back(s.landmark_anchors[keep[k]]);
+      }
+      s.landmark_supine = sup;
+      if (s.prone_source) s.prone_source->landmarks = pro;
+      else s.landmark_anchors = anchors;
+    }
   }
 
   // Tumours.
@@ -208,9 +241,12 @@ Scene load_scene_fields(const std::string& path) {
         validate_surface(m, f + ".prone");
         return m;
       });
-      if (t["supine_ground_truth"])
+      if (t["supine_ground_truth"])  // checked and oriented at load: an inside-out truth gave a volume ratio of -1
         st.supine_ground_truth = c.load(f + ".supine_ground_truth", [&] {
-          return read_surface(c.path_of(t["supine_ground_truth"], f + ".supine_ground_truth"), s.units);
+          SurfaceMesh m = read_surface(c.path_of(t["supine_ground_truth"], f + ".supine_ground_truth"), s.units);
+          repair_orientation(m, f + ".supine_ground_truth", s.warnings);
+          validate_surface(m, f + ".supine_ground_truth");
+          return m;
         });
       s.tumours.push_back(std::move(st));
     }

@@ -519,6 +519,33 @@ TEST(Registration, APartialScanIsNotPulledOntoItsBorder) {
               worst_error(b) * 1e3);
 }
 
+// Issue 11: a landmark pair given twice is merged with a warning, and more landmark vertices
+// than subspace handles are capped with the reason (each row used to add a handle).
+TEST(Landmarks, DuplicatesAreMergedAndHandlesCapped) {
+  std::ifstream in(phantom_dir() + "/landmarks.csv");
+  std::stringstream all;
+  all << in.rdbuf();
+  std::string rows, line;
+  std::istringstream is(all.str());
+  std::getline(is, line);  // header
+  int n = 0;
+  while (std::getline(is, line))
+    if (!line.empty()) rows += line + "\n" + line + "\n", ++n;
+  btr::test::write_text(phantom_dir() + "/landmarks_twice.csv", "prone_index,x,y,z\n" + rows);
+  const Scene s = load_scene(scene_with("landmarks: landmarks_twice.csv", "landmarks_twice"));
+  EXPECT_EQ(s.landmark_supine.rows(), n);
+  ASSERT_FALSE(s.warnings.empty());
+  EXPECT_NE(s.warnings[0].find(std::to_string(n) + " duplicate pairs merged"), std::string::npos) << s.warnings[0];
+  std::vector<std::string> w;
+  const RegistrationModel m = prepare_model(s, w);
+  RegistrationOptions opt = preset_options("fast");
+  opt.landmark.subspace.handles = 3;
+  const RegistrationResult r = run_registration(s, m, opt);
+  bool capped = false;
+  for (const auto& x : r.warnings) capped |= x.find("more than the subspace's 3 handles") != std::string::npos;
+  EXPECT_TRUE(capped);
+}
+
 // Issue 10: without a rigid region the pose is solved with the deformation. On the phantom
 // with its chest ring removed, a scan misaligned by 15 deg / 10 mm must give the aligned
 // result, and the aligned scan must stay close to `steps: [landmarks, surface]` (which is

@@ -33,6 +33,13 @@ TEST(Tetrahedralize, SphereIsFilledWithPositiveWellShapedTetrahedra) {
   EXPECT_GT(finer.T.rows(), 4 * m.T.rows());
 }
 
+TEST(Tetrahedralize, ACellSizeBeyondTheMemoryBudgetIsRefusedBeforeMeshing) {
+  const SurfaceMesh s = make_icosphere(Vec3::Zero(), 0.07, 3);  // about the phantom's volume
+  TetrahedralizeOptions opt;
+  opt.cell_size = 0.0005;
+  btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); }, "this package budgets");
+}
+
 TEST(Tetrahedralize, BadOptionsAreRejected) {
   const SurfaceMesh s = make_icosphere(Vec3::Zero(), 0.05, 1);
   TetrahedralizeOptions opt;

@@ -59,6 +59,7 @@ struct StepReport {
   std::string name;
   bool converged = false;
   std::string stop_reason;
+  std::string note;          ///< something the step limited or changed, for the warnings (empty: none)
   int iterations = 0;        ///< Newton iterations (all outer loops)
   int outer_iterations = 0;  ///< surface projections
   double seconds = 0;

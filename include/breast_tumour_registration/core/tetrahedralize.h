@@ -24,9 +24,13 @@ struct TetQuality {
   double min_volume = 0;          ///< [m^3]
 };
 
+/// The largest mesh this package makes (about 3 GB through meshing and solving).
+constexpr double kMaxTetrahedra = 3e6;
+
 /// Tetrahedralizes the volume bounded by `surface` (closed, consistently oriented; call
 /// validate_surface first). Output tetrahedra are positively oriented. Throws InputError
-/// for bad options or when meshing produces no tetrahedra.
+/// for bad options, for a cell size whose estimated mesh exceeds kMaxTetrahedra (before any
+/// meshing), or when meshing produces no tetrahedra.
 TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& opt);
 
 TetQuality tet_quality(const TetMesh& mesh);
