@@ -1,21 +1,13 @@
 #include "breast_tumour_registration/core/rigid_free_landmark_energy.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/small_matrices.h"
 
 namespace btr {
-namespace {
-Mat3 cross_matrix(const Vec3& s) {
-  Mat3 m;
-  m << 0, -s.z(), s.y(), s.z(), 0, -s.x(), -s.y(), s.x(), 0;
-  return m;
-}
-}  // namespace
-
 RigidFreeLandmarkEnergy::RigidFreeLandmarkEnergy(double weight, std::vector<Anchor> anchors, Points data)
     : weight_(weight), anchors_(std::move(anchors)), data_(std::move(data)) {
   if (!std::isfinite(weight) || weight < 0)
@@ -68,13 +60,7 @@ void RigidFreeLandmarkEnergy::add_hessian(const Points& x, bool project_psd, Hes
     }
   }
   F += J.transpose() * J;
-  // Pseudo-inverse: landmarks on a line leave the rotation about that line free.
-  const Eigen::SelfAdjointEigenSolver<Mat6> es(F);
-  const double floor = 1e-12 * std::max(es.eigenvalues().cwiseAbs().maxCoeff(), 1e-300);
-  Vec6 inv = Vec6::Zero();
-  for (int k = 0; k < 6; ++k)
-    if (std::abs(es.eigenvalues()[k]) > floor) inv[k] = 1.0 / es.eigenvalues()[k];
-  const Mat6 M = es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
+  const Mat6 M = symmetric_pseudo_inverse(F);  // landmarks on a line leave the rotation about it free
   const Eigen::MatrixXd P = Eigen::MatrixXd::Identity(3 * n, 3 * n) - J * M * J.transpose();
   for (Eigen::Index i = 0; i < n; ++i)
     for (Eigen::Index j = 0; j < n; ++j) {

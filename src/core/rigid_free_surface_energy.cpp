@@ -1,29 +1,12 @@
 #include "breast_tumour_registration/core/rigid_free_surface_energy.h"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <limits>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/small_matrices.h"
 
 namespace btr {
-namespace {
-Mat3 cross_matrix(const Vec3& s) {
-  Mat3 m;
-  m << 0, -s.z(), s.y(), s.z(), 0, -s.x(), -s.y(), s.x(), 0;
-  return m;
-}
-
-/// Pseudo-inverse of a symmetric PSD 6x6 matrix (a symmetric scan leaves a rotation free).
-Mat6 pseudo_inverse(const Mat6& F) {
-  const Eigen::SelfAdjointEigenSolver<Mat6> es(F);
-  const double floor = 1e-12 * std::max(es.eigenvalues().cwiseAbs().maxCoeff(), 1e-300);
-  Vec6 inv = Vec6::Zero();
-  for (int k = 0; k < 6; ++k)
-    if (es.eigenvalues()[k] > floor) inv[k] = 1.0 / es.eigenvalues()[k];
-  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
-}
-}  // namespace
 
 RigidFreeSurfaceEnergy::RigidFreeSurfaceEnergy(double point_weight, double plane_weight)
     : point_weight_(point_weight), plane_weight_(plane_weight) {
@@ -87,7 +70,7 @@ Rigid RigidFreeSurfaceEnergy::pose(const Points& x) const {
       F += J.transpose() * A_[j] * J;
       b += J.transpose() * A_[j] * (q - y_[j]);
     }
-    const Vec6 d = -pseudo_inverse(F) * b;
+    const Vec6 d = -symmetric_pseudo_inverse(F) * b;
     if (!d.allFinite()) throw SolverError("pose-free surface springs: pose update is not finite");
     const Vec3 w = d.head<3>();
     Rigid step = Rigid::Identity();
@@ -153,7 +136,7 @@ void RigidFreeSurfaceEnergy::add_low_rank_hessian(const Points& x, std::vector<L
     const Eigen::Matrix<double, 3, 6> QAJ = Qt * A_[j] * J;
     for (int k = 0; k < a.count; ++k) part.W.middleRows<3>(3 * a.v[k]) += a.w[k] * QAJ;
   }
-  part.M = pseudo_inverse(F);
+  part.M = symmetric_pseudo_inverse(F);
   parts.push_back(std::move(part));
 }
 

@@ -6,15 +6,10 @@
 #include <string>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/small_matrices.h"
 
 namespace btr {
 namespace {
-
-Mat3 cross_matrix(const Vec3& v) {
-  Mat3 m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
 
 // vec(cof F) = dJ/dvec(F).
 Vec9 cofactor_vec(const Mat3& F) {

@@ -38,30 +38,39 @@ const std::string& phantom_dir() {
   return dir;
 }
 
-// Copies the phantom scene with extra YAML lines appended (later keys override earlier ones).
-std::string scene_with(const std::string& extra, const std::string& name, const std::string& base = phantom_dir()) {
-  const std::string path = base + "/" + name + ".yaml";
+// A scene folder's scene.yaml as text, and a YAML text without the lines (and their
+// indented children) of a top-level key.
+std::string phantom_scene_text(const std::string& base = phantom_dir()) {
   std::ifstream in(base + "/scene.yaml");
   std::stringstream all;
   all << in.rdbuf();
-  std::string text = all.str();
+  return all.str();
+}
+
+std::string without_key(const std::string& text, const std::string& key) {
+  std::istringstream is(text);
+  std::string out, l;
+  bool skipping = false;
+  while (std::getline(is, l)) {
+    if (l.rfind(key + ":", 0) == 0) { skipping = true; continue; }
+    if (skipping && !l.empty() && (l[0] == ' ' || l[0] == '-')) continue;
+    skipping = false;
+    out += l + "\n";
+  }
+  return out;
+}
+
+// Copies the phantom scene with extra YAML lines appended (later keys override earlier ones).
+std::string scene_with(const std::string& extra, const std::string& name, const std::string& base = phantom_dir()) {
+  const std::string path = base + "/" + name + ".yaml";
+  std::string text = phantom_scene_text(base);
   // Drop keys that `extra` redefines, so the YAML stays valid.
   std::istringstream ex(extra);
   std::string line;
   while (std::getline(ex, line)) {
     const auto colon = line.find(':');
     if (colon == std::string::npos || line.empty() || line[0] == ' ') continue;
-    const std::string key = line.substr(0, colon + 1);
-    std::istringstream is(text);
-    std::string out, l;
-    bool skipping = false;
-    while (std::getline(is, l)) {
-      if (l.rfind(key, 0) == 0) { skipping = true; continue; }
-      if (skipping && !l.empty() && (l[0] == ' ' || l[0] == '-')) continue;
-      skipping = false;
-      out += l + "\n";
-    }
-    text = out;
+    text = without_key(text, line.substr(0, colon));
   }
   std::ofstream(path) << text << extra << "\n";
   return path;
@@ -258,21 +267,8 @@ TEST(SceneErrors, KeysTypesUnitsAndGravityAreChecked) {
   expect_throw_with<InputError>([&] { load_scene(scene_with("units: m", "metre_units")); }, "is `units` right (mm or m)?");
   expect_throw_with<InputError>([&] { load_scene(scene_with("gravity: [0, 0, 0]", "zero_g")); }, "field 'gravity': must not be zero");
   // Without `units` or `gravity` at all.
-  std::ifstream in(phantom_dir() + "/scene.yaml");
-  std::stringstream all;
-  all << in.rdbuf();
-  const std::string text = all.str();
   auto without = [&](const std::string& key, const std::string& name) {
-    std::istringstream is(text);
-    std::string out, l;
-    bool skipping = false;
-    while (std::getline(is, l)) {
-      if (l.rfind(key + ":", 0) == 0) { skipping = true; continue; }
-      if (skipping && !l.empty() && (l[0] == ' ' || l[0] == '-')) continue;
-      skipping = false;
-      out += l + "\n";
-    }
-    btr::test::write_text(phantom_dir() + "/" + name + ".yaml", out);
+    btr::test::write_text(phantom_dir() + "/" + name + ".yaml", without_key(phantom_scene_text(), key));
     return phantom_dir() + "/" + name + ".yaml";
   };
   expect_throw_with<InputError>([&] { load_scene(without("units", "no_units")); }, "field 'units': missing");
@@ -552,11 +548,8 @@ TEST(Landmarks, DuplicatesAreMergedAndHandlesCapped) {
 // told the pose). Measured on this 12 mm phantom: 0.003 mm and 0.06 mm (BENCHMARKS.md has the
 // finer phantom across moduli).
 TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
-  std::ifstream in(phantom_dir() + "/scene.yaml");
-  std::stringstream all;
-  all << in.rdbuf();
   std::string text, line;
-  std::istringstream is(all.str());
+  std::istringstream is(phantom_scene_text());
   while (std::getline(is, line))
     if (line.find("chest_ring:") == std::string::npos) text += line + "\n";
   const std::string dir = phantom_dir();
