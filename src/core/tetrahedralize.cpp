@@ -60,10 +60,13 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
                     p::facet_distance = opt.facet_distance_ratio * h,
                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = h);
   // The optimisers' time limits default to the measured refinement time, which made one input
-  // give several meshes (issue 11); without a limit they stop on their own criteria, and the
-  // domain's random generator is seeded (Random(0)), so one input gives one mesh.
+  // give several meshes (issue 11). Without a time limit they stop when every dihedral angle
+  // is above 10 deg (or nothing improves), and the domain's random generator is seeded
+  // (Random(0)), so one input gives one mesh. Measured on the 6k-vertex phantom surface:
+  // 0.31 s at 4.7 mm (no bound: 2.8 s; CGAL's time limits: about 0.5 s).
   C3t3 c3t3 = opt.optimize ? CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_lloyd(), p::no_odt(),
-                                                     p::perturb(p::time_limit = 0.0), p::exude(p::time_limit = 0.0))
+                                                     p::perturb(p::time_limit = 0.0, p::sliver_bound = 10.0),
+                                                     p::exude(p::time_limit = 0.0, p::sliver_bound = 10.0))
                            : CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_lloyd(), p::no_odt(), p::no_perturb(), p::no_exude());
 
   TetMesh out;
