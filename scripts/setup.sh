@@ -5,7 +5,7 @@
 set -euo pipefail
 
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WS="$REPO_ROOT/build/ws"
+WS="${BTR_WS:-$REPO_ROOT/build/ws}"   # BTR_WS: another workspace (the sanitizer build)
 PKG=breast_tumour_registration
 
 DEB_PACKAGES=(
@@ -51,5 +51,5 @@ export PATH="/usr/bin:$PATH"
 JOBS="${BTR_JOBS:-$(nproc)}"
 cd "$WS"
 echo "[setup] building in $WS (Release, $JOBS jobs)"
-catkin_make -j"$JOBS" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
+catkin_make -j"$JOBS" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="${BTR_BUILD_TYPE:-Release}" \
   -DCATKIN_ENABLE_TESTING=ON "$@"
