@@ -6,7 +6,7 @@ set -uo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$REPO_ROOT/scripts/setup.sh" || { echo "build failed"; echo "0 passed, 1 failed"; exit 1; }
 
-WS="$REPO_ROOT/build/ws"
+WS="${BTR_WS:-$REPO_ROOT/build/ws}"
 export PATH="/usr/bin:$PATH"
 cd "$WS"
 rm -rf build/test_results

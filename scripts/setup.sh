@@ -51,5 +51,8 @@ export PATH="/usr/bin:$PATH"
 JOBS="${BTR_JOBS:-$(nproc)}"
 cd "$WS"
 echo "[setup] building in $WS (Release, $JOBS jobs)"
+# BTR_CMAKE_ARGS: further CMake arguments separated by '|' (the sanitizer build's flags).
+extra=()
+[ -n "${BTR_CMAKE_ARGS:-}" ] && IFS='|' read -r -a extra <<< "$BTR_CMAKE_ARGS"
 catkin_make -j"$JOBS" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE="${BTR_BUILD_TYPE:-Release}" \
-  -DCATKIN_ENABLE_TESTING=ON "$@"
+  -DCATKIN_ENABLE_TESTING=ON "${extra[@]}" "$@"

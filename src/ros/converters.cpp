@@ -89,6 +89,7 @@ sensor_msgs::PointCloud2 to_cloud(const Points& P, int width, int height, const 
   msg.width = width;
   msg.row_step = msg.point_step * width;
   msg.is_dense = false;
+  if (P.rows() == 0) return msg;  // the iterators read data.front(): undefined on an empty cloud (UBSan)
   sensor_msgs::PointCloud2Iterator<float> x(msg, "x"), y(msg, "y"), z(msg, "z");
   for (Eigen::Index i = 0; i < P.rows(); ++i, ++x, ++y, ++z) {
     *x = static_cast<float>(P(i, 0));
