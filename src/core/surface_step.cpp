@@ -61,7 +61,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     held.clear();
     double moved = 0, moved_sq = 0;
     int kept = 0;
-    if (pose && outer > 1) P = free_springs->pose(x);
+    if (pose && outer > 1 && free_springs->size() >= 3) P = free_springs->pose(x);  // fewer: keep the last pose
     held_y.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
     held_n.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
     for (size_t i = 0; i < model.skin.size(); ++i) {
