@@ -6,7 +6,7 @@
 set -uo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 FLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined"
-export BTR_WS="$REPO_ROOT/build/asan_ws" BTR_BUILD_TYPE=RelWithDebInfo
+export BTR_WS="$REPO_ROOT/build/asan_ws" BTR_BUILD_TYPE=RelWithDebInfo BTR_FUZZ_SECONDS=0  # the fuzzers ran in run_tests.sh
 export BTR_CMAKE_ARGS="-DCMAKE_CXX_FLAGS=$FLAGS|-DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined|-DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=address,undefined"
 # detect_leaks=0: ROS's own (uninstrumented) libraries keep memory until exit; leaks are not
 # what this run looks for. alloc_dealloc_mismatch=0: libpcl_registration (Debian's build, not

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's test command: installs what is missing, builds, runs every test
-# (gtest unit tests and rostest integration tests) and fails when any test fails.
+# (gtest unit tests, rostest integration tests and a bounded run of every fuzz target) and
+# fails when any test fails.
 # Ends with the line "N passed, N failed".
 set -uo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -13,6 +14,12 @@ rm -rf build/test_results
 # run_tests exits 0 even when tests fail; catkin_test_results below is the verdict.
 catkin_make -j"${BTR_JOBS:-$(nproc)}" -DPYTHON_EXECUTABLE=/usr/bin/python3 run_tests
 build_rc=$?
+
+# The fuzz targets (test/fuzz), each for a bounded time; their JUnit file joins the others.
+# BTR_FUZZ_SECONDS=0 skips them (the sanitizer workspace, which runs the same tests again).
+if [ "${BTR_FUZZ_SECONDS:-30}" -gt 0 ]; then
+  bash "$REPO_ROOT/scripts/run_fuzz.sh" "${BTR_FUZZ_SECONDS:-30}" "$WS/build/test_results/btr_fuzz/fuzz.xml"
+fi
 
 summary="$(catkin_test_results build/test_results 2>&1)"
 results_rc=$?

@@ -17,6 +17,7 @@ DEB_PACKAGES=(
   libtf2-msgs-dev
   libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
   python3-matplotlib python3-numpy zlib1g-dev cmake g++ make time
+  clang libclang-rt-14-dev  # libFuzzer + sanitizers for scripts/run_fuzz.sh (part of the tests)
 )
 
 missing=()

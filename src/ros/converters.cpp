@@ -40,6 +40,10 @@ CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan) {
   CloudPoints out;
   out.width = static_cast<int>(msg.width);
   out.height = static_cast<int>(msg.height);
+  out.points.resize(0, 3);
+  // No points: done before any pointer into msg.data is formed (an empty buffer has none;
+  // fuzz finding, test/fuzz/corpus/fuzz_pointcloud2/regression_zero_width).
+  if (n == 0) return out;
   out.organized = msg.height > 1;
   const bool organized_keep = keep_nan && out.organized;
   out.points.resize(static_cast<Eigen::Index>(n), 3);

@@ -94,6 +94,18 @@ TEST(Converters, LayoutsThatPointOutsideTheDataAreRefused) {
   sensor_msgs::PointCloud2 no_count = msg;
   no_count.fields[0].count = 0;
   expect_refused(no_count, "field 'x'");
+  // Fuzz finding: zero width, 10 001 rows and no data formed a pointer off an empty buffer
+  // (UBSan). A cloud without points is an empty result, as the node's empty-cloud check expects.
+  sensor_msgs::PointCloud2 no_width = msg;
+  no_width.width = 0;
+  no_width.height = 10001;
+  no_width.row_step = 24;
+  no_width.data.clear();
+  for (const bool keep_nan : {false, true}) {
+    const auto empty = ros_conv::from_cloud(no_width, keep_nan);
+    EXPECT_EQ(empty.points.rows(), 0);
+    EXPECT_EQ(empty.finite, 0);
+  }
 }
 
 TEST(Converters, MeshMarkerAndTransformRoundTrips) {
