@@ -43,6 +43,8 @@ PhantomModel load_rest_model_fields(const std::string& path) {
   // Index files refer to `rest` or, with `surface`, to the surface's vertices; the latter are
   // re-attached to the tetrahedral mesh after meshing (chest wall: boundary vertices on the
   // region; landmarks: the nearest boundary vertex).
+  // Every file is read and checked before the surface (if any) is tetrahedralized: a typo in
+  // the last field must not cost a meshing first (fuzz finding: 10 s of CGAL, then the error).
   SurfaceMesh input_surface;
   if (root["rest"]) {
     m.rest = c.load("rest", [&] {
@@ -60,26 +62,51 @@ PhantomModel load_rest_model_fields(const std::string& path) {
       validate_surface(input_surface, "surface");
       return 0;
     });
+  }
+  const long n_in = root["rest"] ? m.rest.V.rows() : input_surface.V.rows();
+  std::vector<int> wall = c.load("chest_wall", [&] {
+    auto w = read_index_list(c.path_of(root["chest_wall"], "chest_wall"));
+    check_index_range(w, n_in, "chest_wall");
+    if (w.size() < 3) throw InputError("at least 3 fixed vertices are needed");
+    return w;
+  });
+  const auto named = c.load("landmarks", [&] {
+    auto l = read_named_indices(c.path_of(root["landmarks"], "landmarks"));
+    for (const auto& [name, v] : l) check_index_range({v}, n_in, "landmark " + name);
+    return l;
+  });
+  if (root["chest_ring"])
+    m.chest_ring = c.load("chest_ring", [&] { return read_surface(c.path_of(root["chest_ring"], "chest_ring"), unit); });
+  const YAML::Node tumours = root["tumours"];
+  if (!tumours.IsMap() || tumours.size() == 0) c.fail("tumours", "expected a mapping of name: surface file");
+  for (const auto& kv : tumours) {
+    const std::string name = kv.first.as<std::string>(), field = "tumours." + name;
+    m.tumours[name] = c.load(field, [&] {
+      SurfaceMesh s = read_surface(c.path_of(kv.second, field), unit);
+      repair_orientation(s, field, m.warnings);
+      validate_surface(s, field);
+      return s;
+    });
+  }
+  if (!root["rest"]) {
     TetrahedralizeOptions topt;
     topt.cell_size = root["cell_size_mm"] ? c.number(root["cell_size_mm"], "cell_size_mm") * 1e-3 : kDefaultCellSize;
     if (!(topt.cell_size > 0)) c.fail("cell_size_mm", "must be positive");
     m.rest = c.load("cell_size_mm", [&] { return tetrahedralize(input_surface, topt); });
   }
+  // Index files refer to `rest` or, with `surface`, to the surface's vertices; the latter are
+  // re-attached to the tetrahedral mesh (chest wall: boundary vertices on the region;
+  // landmarks: the nearest boundary vertex).
   std::vector<int> boundary;  // tet vertex of every surface vertex
   m.surface = boundary_surface(m.rest, &boundary);
-  const long n = m.rest.V.rows(), n_in = root["rest"] ? n : input_surface.V.rows();
-  m.chest_wall = c.load("chest_wall", [&] {
-    auto w = read_index_list(c.path_of(root["chest_wall"], "chest_wall"));
-    check_index_range(w, n_in, "chest_wall");
-    if (w.size() < 3) throw InputError("at least 3 fixed vertices are needed");
-    if (!root["rest"]) w = boundary_vertices_near_region(m.rest, input_surface, w, 1e-6 + 0.1 * 6e-3);
-    return w;
+  const long n = m.rest.V.rows();
+  m.chest_wall = root["rest"] ? wall : c.load("chest_wall", [&] {
+    return boundary_vertices_near_region(m.rest, input_surface, wall, 1e-6 + 0.1 * 6e-3);
   });
   c.load("landmarks", [&] {
     std::vector<char> on_boundary(n, 0);
     for (int v : boundary) on_boundary[v] = 1;
-    for (const auto& [name, v] : read_named_indices(c.path_of(root["landmarks"], "landmarks"))) {
-      check_index_range({v}, n_in, "landmark " + name);
+    for (const auto& [name, v] : named) {
       int tv = v;
       if (!root["rest"]) {  // nearest boundary vertex of the tetrahedralization
         double best = 1e300;
@@ -93,21 +120,11 @@ PhantomModel load_rest_model_fields(const std::string& path) {
     }
     return 0;
   });
-  if (root["chest_ring"])
-    m.chest_ring = c.load("chest_ring", [&] { return read_surface(c.path_of(root["chest_ring"], "chest_ring"), unit); });
-  const YAML::Node tumours = root["tumours"];
-  if (!tumours.IsMap() || tumours.size() == 0) c.fail("tumours", "expected a mapping of name: surface file");
-  for (const auto& kv : tumours) {
-    const std::string name = kv.first.as<std::string>(), field = "tumours." + name;
-    SurfaceMesh t = c.load(field, [&] {
-      SurfaceMesh s = read_surface(c.path_of(kv.second, field), unit);
-      repair_orientation(s, field, m.warnings);
-      validate_surface(s, field);
-      embed_points(m.rest, s.V, OutsidePolicy::Error);  // every tumour point inside the rest mesh
-      return s;
+  for (const auto& [name, t] : m.tumours)  // every tumour point inside the rest mesh
+    c.load("tumours." + name, [&] {
+      embed_points(m.rest, t.V, OutsidePolicy::Error);
+      return 0;
     });
-    m.tumours[name] = std::move(t);
-  }
   return m;
 }
 }  // namespace
