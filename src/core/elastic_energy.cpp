@@ -3,6 +3,7 @@
 #include <string>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/nodal_volume_energy.h"
 
 namespace btr {
 
@@ -27,34 +28,14 @@ double ElasticEnergy::element_value(const Points& x, Eigen::Index t) const {
 
 Vec12 ElasticEnergy::element_gradient(const Points& x, Eigen::Index t) const {
   const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
-  const Mat3 P = materials_[material_of_[t]].pk1(F);
-  // B^T vec(P): vertex k+1 gets column k of P Dm^-T, vertex 0 minus their sum.
-  const Mat3 G = rest_[t].volume * P * rest_[t].Dm_inv.transpose();
-  Vec12 g;
-  g.segment<3>(3) = G.col(0);
-  g.segment<3>(6) = G.col(1);
-  g.segment<3>(9) = G.col(2);
-  g.segment<3>(0) = -(G.col(0) + G.col(1) + G.col(2));
-  return g;
+  return tet_gradient_from_stress(materials_[material_of_[t]].pk1(F), rest_[t].Dm_inv, rest_[t].volume);
 }
 
 Mat12 ElasticEnergy::element_hessian(const Points& x, Eigen::Index t, bool project_psd) const {
   const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
   const auto& mat = materials_[material_of_[t]];
-  const Mat9 H9 = project_psd ? mat.clamped_hessian(F) : mat.hessian(F);
-  // dF/dx = G^T (x) I3 with G (4x3) the shape-function gradients, so block (a,b) of
-  // B^T H B is sum_jl G(a,j) G(b,l) H_jl (3x3 blocks of H9): a third of the dense flops.
-  const Mat3& Dinv = rest_[t].Dm_inv;
-  Eigen::Matrix<double, 4, 3> G;
-  G.bottomRows<3>() = Dinv;
-  G.row(0) = -Dinv.colwise().sum();
-  Eigen::Matrix<double, 9, 12> HG;  // HG.block(3j, 3b) = sum_l G(b,l) H_jl
-  for (int b = 0; b < 4; ++b)
-    HG.middleCols<3>(3 * b) = G(b, 0) * H9.middleCols<3>(0) + G(b, 1) * H9.middleCols<3>(3) + G(b, 2) * H9.middleCols<3>(6);
-  Mat12 K;
-  for (int a = 0; a < 4; ++a)
-    K.middleRows<3>(3 * a) = G(a, 0) * HG.middleRows<3>(0) + G(a, 1) * HG.middleRows<3>(3) + G(a, 2) * HG.middleRows<3>(6);
-  return rest_[t].volume * K;
+  return tet_hessian_from_stress_hessian(project_psd ? mat.clamped_hessian(F) : mat.hessian(F), rest_[t].Dm_inv,
+                                         rest_[t].volume);
 }
 
 double ElasticEnergy::value(const Points& x) const {
@@ -101,6 +82,44 @@ void ElasticEnergy::add_hessian(const Points& x, bool project_psd, HessianAssemb
       }
     }
   }
+}
+
+VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio) {
+  if (form != VolumeForm::Auto) return form;
+  return poisson_ratio >= kNodalVolumeFromPoisson ? VolumeForm::Nodal : VolumeForm::Element;
+}
+
+VolumeForm parse_volume_form(const std::string& s) {
+  if (s == "auto") return VolumeForm::Auto;
+  if (s == "element") return VolumeForm::Element;
+  if (s == "nodal") return VolumeForm::Nodal;
+  throw InputError("volume form '" + s + "': expected auto, element or nodal");
+}
+
+const char* to_string(VolumeForm form) {
+  switch (form) {
+    case VolumeForm::Auto: return "auto";
+    case VolumeForm::Element: return "element";
+    case VolumeForm::Nodal: return "nodal";
+  }
+  return "?";
+}
+
+void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vector<StableNeoHookean>& materials,
+                        const std::vector<int>& material_of, VolumeForm form) {
+  if (form == VolumeForm::Auto) throw InputError("add_elastic_energy: resolve the volume form first");
+  if (form == VolumeForm::Element) {
+    energy.add(std::make_shared<ElasticEnergy>(rest, materials, material_of));
+    return;
+  }
+  std::vector<StableNeoHookean> shear;
+  for (const auto& m : materials) shear.push_back(m.shear_part());
+  auto elastic = std::make_shared<ElasticEnergy>(rest, shear, material_of);
+  std::vector<double> lambda(rest.T.rows());
+  for (Eigen::Index t = 0; t < rest.T.rows(); ++t)
+    lambda[t] = materials[material_of.empty() ? 0 : material_of[t]].lambda();
+  energy.add(elastic);
+  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda));
 }
 
 }  // namespace btr

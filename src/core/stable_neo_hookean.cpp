@@ -11,14 +11,7 @@
 namespace btr {
 namespace {
 
-// vec(cof F) = dJ/dvec(F).
-Vec9 cofactor_vec(const Mat3& F) {
-  Vec9 g;
-  g.segment<3>(0) = F.col(1).cross(F.col(2));
-  g.segment<3>(3) = F.col(2).cross(F.col(0));
-  g.segment<3>(6) = F.col(0).cross(F.col(1));
-  return g;
-}
+Vec9 cofactor_vec(const Mat3& F) { return determinant_gradient(F); }
 
 Eigen::Map<const Vec9> vec(const Mat3& M) { return Eigen::Map<const Vec9>(M.data()); }
 
@@ -115,14 +108,7 @@ Mat3 StableNeoHookean::pk1(const Mat3& F) const {
 Mat9 StableNeoHookean::hessian(const Mat3& F) const {
   const double J = F.determinant();
   const Vec9 g = cofactor_vec(F);
-  Mat9 HJ = Mat9::Zero();
-  const Mat3 f0 = cross_matrix(F.col(0)), f1 = cross_matrix(F.col(1)), f2 = cross_matrix(F.col(2));
-  HJ.block<3, 3>(0, 3) = -f2;
-  HJ.block<3, 3>(0, 6) = f1;
-  HJ.block<3, 3>(3, 0) = f2;
-  HJ.block<3, 3>(3, 6) = -f0;
-  HJ.block<3, 3>(6, 0) = -f1;
-  HJ.block<3, 3>(6, 3) = f0;
+  const Mat9 HJ = determinant_hessian(F);
   return mu_ * Mat9::Identity() + lambda_ * g * g.transpose() + (lambda_ * (J - 1.0) - mu_) * HJ;
 }
 

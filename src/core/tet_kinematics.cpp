@@ -36,6 +36,31 @@ Mat9x12 deformation_gradient_jacobian(const Mat3& Dm_inv) {
   return B;
 }
 
+Vec12 tet_gradient_from_stress(const Mat3& P, const Mat3& Dm_inv, double volume) {
+  const Mat3 G = volume * P * Dm_inv.transpose();
+  Vec12 g;
+  g.segment<3>(3) = G.col(0);
+  g.segment<3>(6) = G.col(1);
+  g.segment<3>(9) = G.col(2);
+  g.segment<3>(0) = -(G.col(0) + G.col(1) + G.col(2));
+  return g;
+}
+
+Mat12 tet_hessian_from_stress_hessian(const Mat9& H9, const Mat3& Dinv, double volume) {
+  // dF/dx = G^T (x) I3 with G (4x3) the shape-function gradients, so block (a,b) of
+  // B^T H B is sum_jl G(a,j) G(b,l) H_jl (3x3 blocks of H9).
+  Eigen::Matrix<double, 4, 3> G;
+  G.bottomRows<3>() = Dinv;
+  G.row(0) = -Dinv.colwise().sum();
+  Eigen::Matrix<double, 9, 12> HG;  // HG.block(3j, 3b) = sum_l G(b,l) H_jl
+  for (int b = 0; b < 4; ++b)
+    HG.middleCols<3>(3 * b) = G(b, 0) * H9.middleCols<3>(0) + G(b, 1) * H9.middleCols<3>(3) + G(b, 2) * H9.middleCols<3>(6);
+  Mat12 K;
+  for (int a = 0; a < 4; ++a)
+    K.middleRows<3>(3 * a) = G(a, 0) * HG.middleRows<3>(0) + G(a, 1) * HG.middleRows<3>(3) + G(a, 2) * HG.middleRows<3>(6);
+  return volume * K;
+}
+
 long count_inverted(const Points& x, const Tetrahedra& T) {
   long n = 0;
 #pragma omp parallel for reduction(+ : n) schedule(static)

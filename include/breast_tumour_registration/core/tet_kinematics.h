@@ -30,6 +30,11 @@ inline Mat3 deformation_gradient(const Points& x, const Eigen::Vector4i& tet, co
 /// d vec(F) / d x_tet, 9 by 12 (x_tet = [x0; x1; x2; x3]).
 Mat9x12 deformation_gradient_jacobian(const Mat3& Dm_inv);
 
+/// The 12-vector volume * B^T vec(P) of a stress P (4 vertices x 3): an element's gradient
+/// from d psi/dF, without forming B (vertex k+1 gets column k of P Dm^-T, vertex 0 minus their sum).
+Vec12 tet_gradient_from_stress(const Mat3& P, const Mat3& Dm_inv, double volume);
+/// The 12x12 matrix volume * B^T H9 B of a 9x9 d2psi/dvec(F)2, in a third of the dense flops.
+Mat12 tet_hessian_from_stress_hessian(const Mat9& H9, const Mat3& Dm_inv, double volume);
 /// Number of tetrahedra with non-positive signed volume at positions x.
 long count_inverted(const Points& x, const Tetrahedra& T);
 
