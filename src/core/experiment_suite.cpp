@@ -194,7 +194,7 @@ Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& c
 
 void write_experiment_csv_header(std::ostream& out) {
   out << "experiment,setting,variable,value,generating_youngs_modulus_Pa,tumour,centroid_distance_mm,hausdorff_mm,"
-         "volume_ratio,seconds,status\n";
+         "volume_ratio,seconds,landmark_residual_max_mm,skin_distance_mean_mm,status\n";
 }
 
 void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row) {
@@ -204,7 +204,7 @@ void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row) {
   out << row.run->experiment << ',' << row.run->setting << ',' << row.run->variable << ',' << row.run->value << ','
       << row.generating_youngs_modulus << ',' << row.tumour << ',' << std::setprecision(6) << row.centroid_distance_mm
       << ',' << row.hausdorff_mm << ',' << row.volume_ratio << ',' << std::setprecision(4) << row.seconds << ','
-      << status << '\n';
+      << row.landmark_residual_max_mm << ',' << row.skin_distance_mean_mm << ',' << status << '\n';
 }
 
 void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,
@@ -262,10 +262,13 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
             for (const auto& rep : r.reports)
               if (!rep.converged) status += ": " + rep.name + ": " + rep.stop_reason;
           }
+          if (r.implausible) status += " (implausible)";
           for (const auto& t : r.tumours) {
             row.tumour = t.name;
             row.centroid_distance_mm = t.centroid_distance * 1e3;
             row.hausdorff_mm = t.hausdorff * 1e3;
+            row.landmark_residual_max_mm = r.landmark_residual_max * 1e3;
+            row.skin_distance_mean_mm = r.skin_distance_mean * 1e3;
             row.volume_ratio = t.volume_ratio_to_truth;
             row.seconds = r.seconds;
             row.status = status;
@@ -281,6 +284,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
         for (const auto& [name, t] : model.tumours) {
           row.tumour = name;
           row.centroid_distance_mm = row.hausdorff_mm = row.volume_ratio = row.seconds = nan;
+          row.landmark_residual_max_mm = row.skin_distance_mean_mm = nan;
           row.status = failure;
           rows.push_back(row);
         }

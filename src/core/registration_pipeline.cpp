@@ -8,8 +8,10 @@
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/elastic_energy.h"
 #include "breast_tumour_registration/core/metrics.h"
+#include "breast_tumour_registration/core/rigid_regions.h"
 #include "breast_tumour_registration/core/simulation_mesh.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/core/units.h"
 #include "breast_tumour_registration/core/validation.h"
 
 namespace btr {
@@ -20,6 +22,30 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 bool requested(const Scene& s, const char* step) {
   return std::find(s.steps.begin(), s.steps.end(), step) != s.steps.end();
 }
+/// Flags a result that its own data contradict (RegistrationOptions' plausibility bounds).
+void check_plausibility(const RegistrationModel& model, const RegistrationOptions& opt, RegistrationResult& r) {
+  const Vec3 extent = (model.rest.V.colwise().maxCoeff() - model.rest.V.colwise().minCoeff()).transpose();
+  const double diagonal = extent.norm();
+  const double lm_bound = std::max(opt.landmark_residual_bound, opt.landmark_residual_fraction * diagonal);
+  // Only where the landmarks were constraints: without the landmark step their residual
+  // measures how far the skin slid along the surface, which the surface step leaves free.
+  if (r.steps.landmarks && r.landmark_residual_max > lm_bound) {
+    r.implausible = true;
+    r.warnings.push_back("implausible result: a landmark ends " + format_mm(r.landmark_residual_max) +
+                         " from its supine position (bound " + format_mm(lm_bound) +
+                         "): the model cannot follow its data (far too stiff, locking near nu = 0.5, a wrong "
+                         "pose, or a mislabelled landmark pair)");
+  }
+  const double skin_bound = std::max(opt.skin_distance_bound, opt.skin_distance_fraction * diagonal);
+  if (r.skin_distance_mean > skin_bound) {
+    r.implausible = true;
+    r.warnings.push_back("implausible result: the skin ends " + format_mm(r.skin_distance_mean) +
+                         " from the supine surface on average (bound " + format_mm(skin_bound) +
+                         "): a wrong pose, a scan of another region, or a model that cannot follow it");
+  }
+  if (r.rigid_pose_undecided) r.implausible = true;
+}
+
 }  // namespace
 
 RegistrationOptions preset_options(const std::string& name) {
@@ -142,29 +168,35 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     T = *opt.known_supine_to_model;
     r.steps.rigid_landmarks = r.steps.rigid_icp = false;
   }
+  Points lm_supine, lm_prone;  // landmark pairs for the rigid step (none when it does not use them)
   if (r.steps.rigid_landmarks) {
-    Points prone_lm(scene.landmark_anchors.size(), 3);
+    lm_supine = scene.landmark_supine;
+    lm_prone.resize(scene.landmark_anchors.size(), 3);
     for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
-      prone_lm.row(i) = scene.landmark_anchors[i].position(model.rest.V).transpose();
-    T = kabsch(scene.landmark_supine, prone_lm);
+      lm_prone.row(i) = scene.landmark_anchors[i].position(model.rest.V).transpose();
+    T = kabsch(lm_supine, lm_prone);
   }
   const bool joint_pose = r.steps.rigid_landmarks && r.steps.landmarks;
   if (r.steps.rigid_icp) {
     // ICP starts from the landmark fit, the identity and the centroid-matched regions; the
-    // accepted result with the lowest inlier RMS wins.
+    // accepted result with the lowest inlier RMS wins, unless the regions are symmetric and
+    // fit turned poses equally well (then the landmarks decide, see rigid_regions.h).
     std::vector<Rigid> starts = {T};
     if (r.steps.rigid_landmarks) starts.push_back(Rigid::Identity());
     Rigid centred = Rigid::Identity();
     centred.translation() = (scene.prone_rigid->V.colwise().mean() - scene.supine_rigid->V.colwise().mean()).transpose();
     starts.push_back(centred);
-    bool have = false;
-    for (const Rigid& s : starts) {
-      const IcpResult icp = align_icp(scene.supine_rigid->V, scene.prone_rigid->V, s, opt.icp);
-      if (!have || (icp.accepted && (!r.icp.accepted || icp.inlier_rms < r.icp.inlier_rms))) {
-        r.icp = icp;
-        have = true;
-      }
-    }
+    RigidRegionOptions ro = opt.rigid_regions;
+    ro.icp = opt.icp;
+    const RigidRegionChoice choice =
+        align_rigid_regions(scene.supine_rigid->V, scene.prone_rigid->V, starts, lm_supine, lm_prone, ro);
+    r.icp = choice.icp;
+    r.rigid_distinct_poses = choice.distinct_poses;
+    r.rigid_decided_by_landmarks = choice.decided_by_landmarks;
+    r.rigid_pose_undecided = choice.undecided;
+    r.rigid_note = choice.note;
+    // A symmetric ring that the landmarks resolve is information; one nothing resolves is a warning.
+    if (choice.undecided) r.warnings.push_back("rigid alignment: " + choice.note);
     if (r.icp.accepted) {
       T = r.icp.transform;
       r.icp_used = true;
@@ -183,10 +215,11 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   if (r.steps.gravity) {
     const auto tg = Clock::now();
     TotalEnergy energy;
-    energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
+    add_model_elastic_energy(energy, model);
     auto g = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
     energy.add(g);
-    NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed),
+    NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed,
+                                                         energy.hessian_cliques()),
                         model.rest.T);
     NewtonOptions nopt = opt.gravity;
     nopt.force_scale = g->total_weight();
@@ -293,6 +326,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     r.skin_distance_mean = st.mean;
     r.skin_distance_max = st.max;
   }
+  check_plausibility(model, opt, r);
   return r;
 }
 

@@ -40,6 +40,7 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   std::ostringstream j;
   j << "{\n  \"scene\": " << quote(scene.path) << ",\n  \"preset\": " << quote(scene.preset)
     << ",\n  \"steps\": " << quote(r.steps.describe()) << ",\n  \"converged\": " << (r.converged ? "true" : "false")
+    << ",\n  \"implausible\": " << (r.implausible ? "true" : "false")
     << ",\n  \"mesh\": {\"vertices\": " << model.rest.V.rows() << ", \"tetrahedra\": " << model.rest.T.rows()
     << ", \"chest_wall_vertices\": " << model.chest_wall.size() << ", \"skin_vertices\": " << model.skin.size()
     << ", \"stiff_tumour_tetrahedra\": " << model.stiff_tetrahedra << "},\n";
@@ -55,7 +56,10 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
     << ", \"rotation_deg\": " << num(rotation_angle(r.supine_to_model) * 180 / M_PI) << ", \"icp_used\": "
     << (r.icp_used ? "true" : "false") << ", \"pose_solved_with_landmarks\": " << (r.pose_solved_with_landmarks ? "true" : "false")
     << ", \"pose_solved_with_surface\": " << (r.pose_solved_with_surface ? "true" : "false")
-    << ", \"icp_vs_landmark_pose_mm\": " << num(r.pose_disagreement * 1e3) << ", \"icp\": {\"accepted\": " << (r.icp.accepted ? "true" : "false")
+    << ", \"icp_vs_landmark_pose_mm\": " << num(r.pose_disagreement * 1e3)
+    << ", \"rigid_regions\": {\"distinct_poses\": " << r.rigid_distinct_poses
+    << ", \"decided_by_landmarks\": " << (r.rigid_decided_by_landmarks ? "true" : "false")
+    << ", \"undecided\": " << (r.rigid_pose_undecided ? "true" : "false") << ", \"note\": " << quote(r.rigid_note) << "}" << ", \"icp\": {\"accepted\": " << (r.icp.accepted ? "true" : "false")
     << ", \"converged\": " << (r.icp.converged ? "true" : "false") << ", \"inlier_rms_mm\": " << num(r.icp.inlier_rms * 1e3)
     << ", \"overlap\": " << num(r.icp.overlap) << ", \"iterations\": " << r.icp.iterations
     << ", \"message\": " << quote(r.icp.message) << "}},\n";

@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/core/units.h"
 
+#include <cstdio>
+
 #include <algorithm>
 #include <cctype>
 
@@ -19,5 +21,11 @@ LengthUnit parse_length_unit(const std::string& s) {
 }
 
 std::string to_string(LengthUnit u) { return u == LengthUnit::Metre ? "m" : "mm"; }
+
+std::string format_mm(double metres, int decimals) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.*f mm", decimals, metres * 1e3);
+  return b;
+}
 
 }  // namespace btr

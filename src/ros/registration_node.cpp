@@ -347,7 +347,9 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       if (!step.converged) res.message += "; the " + step.name + " step stopped without converging (" + step.stop_reason + ")";
     }
     if (!r.converged) res.message += "; not converged: the result is the last state, see the step reports";
-    publish_status(r.converged ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN, res.message);
+    if (r.implausible) res.message += "; implausible: see the result's warnings";
+    publish_status(r.converged && !r.implausible ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN,
+                   res.message);
   } catch (const NotReady& e) {  // waiting for data is not an error
     res.success = false;
     res.message = e.what();
@@ -376,6 +378,7 @@ void RegistrationNode::publish_result(const RegistrationResult& r, const Registr
   out.preset = preset;
   out.steps = r.steps.describe();
   out.converged = r.converged;
+  out.implausible = r.implausible;
   out.registration_seconds = r.seconds;
   out.landmark_residual_mean = r.landmark_residual_mean;
   out.skin_distance_mean = r.skin_distance_mean;

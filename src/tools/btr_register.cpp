@@ -20,7 +20,9 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Deform the prone breast model of a scene into the supine position (Yeh 2023: rigid alignment, landmark-guided\n"
       "subspace step, surface-guided step) and write the registered tumour(s), meshes, report.json and a PNG.\n"
-      "Exit codes: 0 converged, 2 invalid input, 3 numerical failure, 4 finished without converging (outputs written)."};
+      "Exit codes: 0 converged, 2 invalid input, 3 numerical failure, 4 finished without converging (outputs written),\n"
+      "5 converged but implausible: a landmark or the skin ends far from its data, or the rigid pose was undecided\n"
+      "(outputs written; the warnings say which)."};
   std::string scene_path, out_dir = "registration", preset, steps;
   double tumour_E = 0, cell_mm = -1;
   bool quiet = false;
@@ -94,6 +96,7 @@ int main(int argc, char** argv) {
       std::printf("[rigid   ] %.2f deg, %.2f mm (%s) in %.3f s\n", rotation_angle(r.supine_to_model) * 180 / M_PI,
                   r.supine_to_model.translation().norm() * 1e3, r.icp_used ? "landmarks + ICP" : r.icp.message.empty() ? "landmarks" : r.icp.message.c_str(),
                   r.rigid_seconds);
+    if (!r.rigid_note.empty() && !r.rigid_pose_undecided) std::printf("[rigid   ] %s\n", r.rigid_note.c_str());
     for (const auto& s : r.reports) {
       std::printf("[%-8s] %s: %d Newton iterations%s in %.3f s\n", s.name.c_str(), s.stop_reason.c_str(), s.iterations,
                   s.outer_iterations ? (", " + std::to_string(s.outer_iterations) + " projections").c_str() : "", s.seconds);
@@ -121,6 +124,10 @@ int main(int argc, char** argv) {
     if (!r.converged) {
       std::fprintf(stderr, "btr_register: a step stopped without converging (see report.json); try the accurate preset\n");
       return 4;
+    }
+    if (r.implausible) {
+      std::fprintf(stderr, "btr_register: the result is implausible (see the warnings above and report.json)\n");
+      return 5;
     }
     return 0;
   } catch (const InputError& e) {

@@ -77,12 +77,12 @@ TEST(ExperimentSuite, QuickRunReproducesTheThesisFindings) {
   });
   EXPECT_EQ(s.rows, static_cast<int>(runs.size()) * 5);
   EXPECT_EQ(s.nonfinite, 0);
-  // One header and one line per row, eleven fields each.
+  // One header and one line per row, thirteen fields each.
   std::istringstream lines(csv.str());
   std::string line;
   int n = 0;
   while (std::getline(lines, line)) {
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 10) << line;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 12) << line;
     ++n;
   }
   EXPECT_EQ(n, s.rows + 1);

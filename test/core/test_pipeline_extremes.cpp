@@ -13,6 +13,7 @@
 #include "breast_tumour_registration/core/phantom.h"
 #include "breast_tumour_registration/core/phantom_scene.h"
 #include "breast_tumour_registration/core/registration_pipeline.h"
+#include "breast_tumour_registration/core/rigid_regions.h"
 #include "breast_tumour_registration/core/shapes.h"
 #include "breast_tumour_registration/core/tet_kinematics.h"
 #include "test_util.h"
@@ -205,4 +206,70 @@ TEST(PipelineLandmarks, PulledThroughTheChestWall) {
   EXPECT_GT(o.r.landmark_residual_max, 0.01);
   std::printf("landmarks pulled through the chest wall: residual %.1f mm, no inverted element\n",
               o.r.landmark_residual_max * 1e3);
+}
+
+namespace {
+/// The scene's supine side (surface, rigid region, landmarks, truth) moved by T.
+void move_supine(Scene& s, const Rigid& T) {
+  s.supine_surface = transform_surface(T, *s.supine_surface);
+  s.supine_rigid = transform_surface(T, *s.supine_rigid);
+  s.landmark_supine = transform_points(T, s.landmark_supine);
+  for (auto& t : s.tumours) t.supine_ground_truth = transform_surface(T, *t.supine_ground_truth);
+}
+/// A half turn about the axis of the (rotationally symmetric) chest ring, through its centre.
+Rigid half_turn_about_ring(const Scene& s) {
+  const Vec3 c = s.supine_rigid->V.colwise().mean().transpose();
+  Rigid T = Rigid::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI, least_spread_axis(s.supine_rigid->V)).toRotationMatrix();
+  T.translation() = c - T.linear() * c;
+  return T;
+}
+}  // namespace
+
+// Issue 11: the phantom's chest ring fits itself as well turned by 180 deg as not, so ICP
+// from the identity "accepts" a flipped scan with a perfect residual. The symmetry probe
+// finds the equally good poses and the landmarks choose the right one.
+TEST(PipelineFlip, AHalfTurnedScanIsRecognisedAndTheLandmarksDecide) {
+  const Outcome o = run(coarse_dir() + "/scene.yaml", [&](Scene& s, RegistrationOptions&) { move_supine(s, half_turn_about_ring(s)); });
+  expect_finite(o);
+  EXPECT_GE(o.r.rigid_distinct_poses, 2);
+  EXPECT_FALSE(o.r.rigid_pose_undecided);
+  EXPECT_TRUE(o.r.rigid_decided_by_landmarks);
+  EXPECT_FALSE(o.r.implausible);
+  EXPECT_NE(o.r.rigid_note.find("the landmarks decided"), std::string::npos) << o.r.rigid_note;
+  std::printf("half-turned scan: %d distinct ring poses, worst tumour error %.3f mm\n", o.r.rigid_distinct_poses, worst(o) * 1e3);
+  EXPECT_LT(worst(o), 2e-3);
+}
+
+// Without landmarks nothing can decide: the result says so and is flagged implausible
+// (btr_register exits 5), instead of a perfect-looking ICP and a tumour 60 mm off.
+TEST(PipelineFlip, WithoutLandmarksAHalfTurnIsReportedUndecided) {
+  const Outcome o = run(coarse_dir() + "/scene.yaml", [&](Scene& s, RegistrationOptions&) {
+    move_supine(s, half_turn_about_ring(s));
+    s.landmark_anchors.clear();
+    s.landmark_supine.resize(0, 3);
+  });
+  expect_finite(o);
+  EXPECT_TRUE(o.r.rigid_pose_undecided);
+  EXPECT_TRUE(o.r.implausible);
+  bool said = false;
+  for (const auto& w : o.r.warnings) said = said || w.find("no landmarks to decide") != std::string::npos;
+  EXPECT_TRUE(said);
+  std::printf("half-turned scan, no landmarks: worst tumour error %.3f mm, flagged implausible\n", worst(o) * 1e3);
+}
+
+// Issue 11: a model that cannot follow its data (far too stiff) ends with its landmarks far
+// from their targets; that is flagged, where the same scene with a sane E is not.
+TEST(PipelinePlausibility, AModelThatCannotFollowItsDataIsFlagged) {
+  const Outcome sane = run(coarse_dir() + "/scene.yaml");
+  EXPECT_FALSE(sane.r.implausible) << "landmark residual " << sane.r.landmark_residual_max * 1e3 << " mm, skin "
+                                   << sane.r.skin_distance_mean * 1e3 << " mm";
+  const Outcome stiff = run(coarse_dir() + "/scene.yaml", [&](Scene& s, RegistrationOptions&) { s.material.youngs_modulus = 1e9; });
+  std::printf("E 3400 Pa: landmark residual %.2f mm, skin %.2f mm; E 1e9 Pa: %.2f mm, %.2f mm\n",
+              sane.r.landmark_residual_max * 1e3, sane.r.skin_distance_mean * 1e3, stiff.r.landmark_residual_max * 1e3,
+              stiff.r.skin_distance_mean * 1e3);
+  EXPECT_TRUE(stiff.r.implausible);
+  bool said = false;
+  for (const auto& w : stiff.r.warnings) said = said || w.find("implausible result") != std::string::npos;
+  EXPECT_TRUE(said);
 }

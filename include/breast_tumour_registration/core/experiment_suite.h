@@ -59,7 +59,8 @@ struct ExperimentRow {
   double generating_youngs_modulus = 0;
   std::string tumour;
   double centroid_distance_mm = 0, hausdorff_mm = 0, volume_ratio = 0, seconds = 0;
-  std::string status;  ///< converged, "not_converged: step: reason ...", or "failed: message"
+  double landmark_residual_max_mm = 0, skin_distance_mean_mm = 0;  ///< the figures the plausibility check reads
+  std::string status;  ///< converged, "not_converged: step: reason ...", or "failed: message"; " (implausible)" appended when flagged
 };
 
 /// CSV header and row writers (one row per run and tumour).

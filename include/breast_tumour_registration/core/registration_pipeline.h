@@ -9,6 +9,7 @@
 
 #include "breast_tumour_registration/core/icp_alignment.h"
 #include "breast_tumour_registration/core/landmark_step.h"
+#include "breast_tumour_registration/core/rigid_regions.h"
 #include "breast_tumour_registration/core/scene.h"
 #include "breast_tumour_registration/core/surface_step.h"
 
@@ -17,6 +18,7 @@ namespace btr {
 struct RegistrationOptions {
   std::string preset = "balanced";
   IcpOptions icp;
+  RigidRegionOptions rigid_regions;  ///< symmetry checks of the rigid regions (its icp field is replaced by `icp`)
   LandmarkStepOptions landmark;
   SurfaceStepOptions surface;
   NewtonOptions gravity;  ///< gravity pre-step
@@ -29,6 +31,17 @@ struct RegistrationOptions {
   /// [m] When ICP on the rigid regions decides the pose and the pose solved jointly with the
   /// landmarks moves the rigid region by more than this, the result carries a warning.
   double pose_disagreement_warning = 0.003;
+  /// Plausibility of the result (a result far from its own data is not an answer, whatever
+  /// the solver's verdict): it is flagged `implausible`, with a warning, when the largest
+  /// landmark residual (when the landmark step ran) exceeds max(landmark_residual_bound, landmark_residual_fraction x the
+  /// prone model's bounding-box diagonal), or the mean distance of the skin to the supine
+  /// surface exceeds max(skin_distance_bound, skin_distance_fraction x that diagonal).
+  /// Chosen on two bodies (BENCHMARKS.md): far above what converged runs show, below a
+  /// model that cannot follow its data (locked, far too stiff) or a flipped pose.
+  double landmark_residual_bound = 0.005;      ///< [m]
+  double landmark_residual_fraction = 0.02;
+  double skin_distance_bound = 0.002;          ///< [m]
+  double skin_distance_fraction = 0.01;
 };
 
 /// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
@@ -82,6 +95,10 @@ struct RegistrationResult {
   IcpResult icp;
   bool pose_solved_with_landmarks = false;  ///< the landmark step solved the pose (no decisive ICP)
   bool pose_solved_with_surface = false;    ///< the surface step refined it (no decisive ICP)
+  int rigid_distinct_poses = 0;       ///< distinct poses the rigid regions fit equally well (> 1: symmetric)
+  bool rigid_decided_by_landmarks = false;  ///< several of them, and the landmarks chose
+  bool rigid_pose_undecided = false;  ///< several of them and nothing told them apart (a warning says so)
+  std::string rigid_note;             ///< what the symmetry check found (empty: one pose fits)
   double pose_disagreement = 0;  ///< [m] ICP vs joint landmark pose, max over the rigid region (when both ran)
   double rigid_seconds = 0;
   std::vector<StepReport> reports;
@@ -91,6 +108,9 @@ struct RegistrationResult {
   double landmark_residual_mean = 0, landmark_residual_max = 0;  ///< [m]
   double skin_distance_mean = 0, skin_distance_max = 0;          ///< [m] to the supine surface
   bool converged = true;
+  /// The result is far from its own data (see RegistrationOptions' plausibility bounds) or
+  /// the rigid pose was left undecided; `warnings` says which. btr_register exits with 5.
+  bool implausible = false;
   std::vector<std::string> warnings;
 };
 

@@ -13,4 +13,7 @@ double metres_per_unit(LengthUnit u);
 LengthUnit parse_length_unit(const std::string& s);
 std::string to_string(LengthUnit u);
 
+/// A length [m] for messages, in millimetres: format_mm(0.00123) is "1.2 mm".
+std::string format_mm(double metres, int decimals = 1);
+
 }  // namespace btr
