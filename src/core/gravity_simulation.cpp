@@ -27,10 +27,11 @@ GravityResult solve_gravity(const GravityProblem& pb, const NewtonOptions& optio
       material_of[t] = 1;
     }
   }
-  energy.add(std::make_shared<ElasticEnergy>(rest, materials, material_of));
+  add_elastic_energy(energy, rest, materials, material_of, resolve_volume_form(pb.volume_form, pb.poisson_ratio));
   auto gravity = std::make_shared<GravityEnergy>(rest, pb.density, pb.gravity);
   energy.add(gravity);
-  auto assembler = std::make_shared<HessianAssembler>(static_cast<int>(rest.V.rows()), rest.T, fixed);
+  auto assembler =
+      std::make_shared<HessianAssembler>(static_cast<int>(rest.V.rows()), rest.T, fixed, energy.hessian_cliques());
   NewtonSolver solver(assembler, rest.T);
   GravityResult r;
   r.x = rest.V;

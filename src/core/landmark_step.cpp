@@ -22,7 +22,7 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
     throw InputError("landmark step: " + std::to_string(anchors.size()) + " prone landmarks but " +
                      std::to_string(targets.rows()) + " supine targets");
   TotalEnergy energy;
-  energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
+  add_model_elastic_energy(energy, model);
   auto gravity = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
   if (opt.gravity) energy.add(gravity);
   auto springs = std::make_shared<PointConstraintEnergy>(opt.weight);
@@ -57,7 +57,7 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
     energy.add(springs);
   }
   const SkinningSubspace S = build_skinning_subspace(model.rest.V, model.volume, seeds, model.fixed, opt.subspace);
-  HessianAssembler H(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed, cliques);
+  HessianAssembler H(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed, energy.hessian_cliques(cliques));
   NewtonOptions nopt = opt.newton;
   if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
   if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("landmark", it); };

@@ -31,6 +31,7 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     pb.fixed = model.chest_wall;
     pb.youngs_modulus = opt.youngs_modulus;
     pb.poisson_ratio = opt.poisson_ratio;
+    pb.volume_form = opt.volume_form;
     pb.density = opt.density;
     pb.gravity = g;
     pb.inclusion = inclusion;
@@ -132,6 +133,7 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   scene["preset"] = "balanced";
   scene["generator"]["youngs_modulus"] = opt.youngs_modulus;
   scene["generator"]["poisson_ratio"] = opt.poisson_ratio;
+  scene["generator"]["volume_form"] = to_string(resolve_volume_form(opt.volume_form, opt.poisson_ratio));
   scene["generator"]["density"] = opt.density;
   scene["generator"]["tumour_youngs_modulus"] = opt.tumour_youngs_modulus;
   scene["generator"]["cell_size_mm"] = opt.phantom.tet.cell_size * 1e3;

@@ -28,6 +28,7 @@ RegistrationModel make_registration_model(const TetMesh& prone, const std::vecto
   if (m.skin.empty()) throw InputError("chest wall: every boundary vertex is fixed, no skin is left to register");
   m.material = material;
   m.materials = {StableNeoHookean(material.youngs_modulus, material.poisson_ratio)};
+  m.volume_form = resolve_volume_form(material.volume_form, material.poisson_ratio);
   if (!(material.density > 0) || !std::isfinite(material.density))
     throw InputError("material.density must be positive (kg/m^3)");
   m.material_of.assign(m.rest.T.rows(), 0);
@@ -47,6 +48,10 @@ int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceM
   return outside;
 }
 
+
+void add_model_elastic_energy(TotalEnergy& energy, const RegistrationModel& model) {
+  add_elastic_energy(energy, model.rest, model.materials, model.material_of, model.volume_form);
+}
 
 void stiffen_tumours(RegistrationModel& model, double E) {
   model.materials.erase(model.materials.begin() + 1, model.materials.end());

@@ -40,7 +40,7 @@ const std::vector<std::string> kSceneKeys = {
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
-    "material.youngs_modulus", "material.poisson_ratio", "material.density", "tumour_material",
+    "material.youngs_modulus", "material.poisson_ratio", "material.density", "material.volume_form", "tumour_material",
     "tumour_material.youngs_modulus", "gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
     "misalignment.translation_mm", "generator.*"};
 
@@ -257,6 +257,11 @@ Scene load_scene_fields(const std::string& path) {
     if (m["youngs_modulus"]) s.material.youngs_modulus = c.number(m["youngs_modulus"], "material.youngs_modulus");
     if (m["poisson_ratio"]) s.material.poisson_ratio = c.number(m["poisson_ratio"], "material.poisson_ratio");
     if (m["density"]) s.material.density = c.number(m["density"], "material.density");
+    if (m["volume_form"])
+      c.load("material.volume_form", [&] {
+        s.material.volume_form = parse_volume_form(c.text(m["volume_form"], "material.volume_form"));
+        return 0;
+      });
   }
   c.load("material", [&] { StableNeoHookean(s.material.youngs_modulus, s.material.poisson_ratio); return 0; });
   if (!(s.material.density > 0)) c.fail("material.density", "must be positive (kg/m^3)");

@@ -21,7 +21,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     throw InputError("surface step: max_projections and newton_per_projection must be >= 1");
 
   TotalEnergy energy;
-  energy.add(std::make_shared<ElasticEnergy>(model.rest, model.materials, model.material_of));
+  add_model_elastic_energy(energy, model);
   auto gravity = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
   if (opt.gravity) energy.add(gravity);
   auto points = std::make_shared<PointConstraintEnergy>(opt.point_weight);
@@ -34,7 +34,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     energy.add(points);
     energy.add(planes);
   }
-  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed),
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed,
+                                                         energy.hessian_cliques()),
                       model.rest.T);
   NewtonOptions nopt = opt.newton;
   nopt.max_iterations = opt.newton_per_projection;

@@ -36,4 +36,14 @@ LowRankHessian TotalEnergy::low_rank_hessian(const Points& x, const HessianAssem
   return out;
 }
 
+std::vector<std::vector<int>> TotalEnergy::hessian_cliques(std::vector<std::vector<int>> extra) const {
+  std::vector<std::vector<int>> all;
+  for (const auto& t : terms_) {
+    auto c = t->hessian_cliques();
+    all.insert(all.end(), std::make_move_iterator(c.begin()), std::make_move_iterator(c.end()));
+  }
+  all.insert(all.end(), std::make_move_iterator(extra.begin()), std::make_move_iterator(extra.end()));
+  return all;
+}
+
 }  // namespace btr

@@ -42,6 +42,10 @@ int main(int argc, char** argv) {
   app.add_option("--tumour-youngs-modulus", tumour_E, "generate with stiff tumours of this Young's modulus [Pa] (0: homogeneous)")
       ->capture_default_str()
       ->check(btr::cli::non_negative());
+  std::string volume_form = "auto";
+  app.add_option("--volume-form", volume_form, "volume term of the generating material: auto, element or nodal "
+                                               "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
+      ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no per-iteration progress");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
@@ -52,6 +56,7 @@ int main(int argc, char** argv) {
     o.landmark_set = landmark_set;
     o.youngs_modulus = E;
     o.poisson_ratio = nu;
+    o.volume_form = parse_volume_form(volume_form);
     o.density = rho;
     o.phantom.tet.cell_size = cell_mm * 1e-3;
     o.phantom.tet.radius_edge_ratio = ratio;

@@ -7,6 +7,7 @@
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/newton_solver.h"
+#include "breast_tumour_registration/core/nodal_volume_energy.h"
 #include "breast_tumour_registration/core/plane_constraint_energy.h"
 #include "breast_tumour_registration/core/point_constraint_energy.h"
 #include "breast_tumour_registration/core/rigid_free_landmark_energy.h"
@@ -115,6 +116,34 @@ TEST(ElasticEnergy, ProjectedHessianIsPositiveSemiDefiniteUnderInversion) {
   const Eigen::MatrixXd Hd(H.matrix());
   const double min_eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Hd).eigenvalues().minCoeff();
   EXPECT_GE(min_eig, -1e-9 * Hd.norm());
+}
+
+TEST(NodalVolumeEnergy, GradientAndHessianMatchFiniteDifferences) {
+  const TetMesh m = small_mesh();
+  std::vector<double> lambda(m.T.rows(), 5e4);
+  for (Eigen::Index t = 0; t < m.T.rows(); t += 3) lambda[t] = 2e5;  // heterogeneous
+  const NodalVolumeEnergy e(m, lambda);
+  check_term(e, m, perturbed(m, 0.004, 11), e.hessian_cliques());
+}
+
+TEST(NodalVolumeEnergy, EqualsTheElementFormUnderUniformDeformationAndProjectsToPsd) {
+  const TetMesh m = small_mesh();
+  const StableNeoHookean mat(3400, 0.499);
+  const std::vector<double> lambda(m.T.rows(), mat.lambda());
+  const NodalVolumeEnergy nodal(m, lambda);
+  const ElasticEnergy full(m, {mat}), shear(m, {mat.shear_part()});
+  Mat3 A;
+  A << 1.1, 0.05, 0.0, -0.02, 0.93, 0.04, 0.01, 0.0, 1.02;
+  const Points x = (m.V * A.transpose()).eval();
+  EXPECT_NEAR(shear.value(x) + nodal.value(x), full.value(x), 1e-9 * full.value(x));
+  EXPECT_NEAR(nodal.value(m.V), 0.0, 1e-15);
+  // Strongly compressed and partly inverted: the projected Hessian is PSD.
+  Points y = perturbed(m, 0.02, 5);
+  HessianAssembler H(static_cast<int>(m.V.rows()), m.T, {}, nodal.hessian_cliques());
+  nodal.add_hessian(y, true, H);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(H.matrix()));
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-8 * es.eigenvalues().cwiseAbs().maxCoeff());
+  EXPECT_GT(count_inverted(y, m.T), 0) << "the check should include inverted elements";
 }
 
 TEST(GravityEnergy, GradientMatchesFiniteDifferencesAndMassIsConserved) {

@@ -15,8 +15,8 @@ struct Sag {
 
 // Cantilever of length L, square section h, clamped at x = 0, sagging under its own weight
 // (g along -z). Timoshenko beam: delta = q L^4 / (8 E I) + q L^2 / (2 kappa G A).
-Sag cantilever_tip_sag(int n_long, int n_section) {
-  const double L = 0.2, h = 0.02, E = 1e8, nu = 0.0, rho = 1000, g = 9.81;
+Sag cantilever_tip_sag(int n_long, int n_section, double nu = 0.0, VolumeForm form = VolumeForm::Auto) {
+  const double L = 0.2, h = 0.02, E = 1e8, rho = 1000, g = 9.81;
   const TetMesh m = make_box_tet_mesh(n_long, n_section, n_section, Vec3(L, h, h), Vec3(0, -h / 2, -h / 2));
   GravityProblem pb;
   pb.rest = &m;
@@ -26,6 +26,7 @@ Sag cantilever_tip_sag(int n_long, int n_section) {
   pb.poisson_ratio = nu;
   pb.density = rho;
   pb.gravity = Vec3(0, 0, -g);
+  pb.volume_form = form;
   NewtonOptions opt;
   opt.gradient_rel_tolerance = 1e-10;
   const GravityResult r = solve_gravity(pb, opt);
@@ -57,6 +58,30 @@ TEST(Mechanics, CantileverSagConvergesToBeamTheoryUnderRefinement) {
     previous = err;
   }
   EXPECT_LT(previous, 0.07);
+}
+
+// Issue 11: near incompressibility. Beam theory's bending sag depends on E alone (and on nu
+// only through the small shear term), so a cantilever at nu -> 0.5 must sag about as much as
+// at nu = 0. Linear tetrahedra with the element volume term lock (every element keeps its
+// volume) and barely bend; the nodal-averaged volume term does not.
+TEST(Mechanics, NearIncompressibleCantileverDoesNotLockWithTheNodalVolumeTerm) {
+  // On this mesh linear tetrahedra are too stiff in bending even at nu = 0 (17.5 %, the test
+  // above); near incompressibility may add little to that.
+  const Sag compressible = cantilever_tip_sag(40, 4, 0.0, VolumeForm::Element);
+  const double e0 = std::abs(compressible.fem - compressible.exact) / compressible.exact;
+  for (const double nu : {0.45, 0.49, 0.499, 0.4999}) {
+    const Sag element = cantilever_tip_sag(40, 4, nu, VolumeForm::Element);
+    const Sag nodal = cantilever_tip_sag(40, 4, nu, VolumeForm::Nodal);
+    const double e_el = std::abs(element.fem - element.exact) / element.exact;
+    const double e_no = std::abs(nodal.fem - nodal.exact) / nodal.exact;
+    std::printf("cantilever 40x4x4, nu %.4f: beam theory %.4f mm; element form %.4f mm (%.1f%%), nodal form %.4f mm (%.1f%%)\n",
+                nu, nodal.exact * 1e3, element.fem * 1e3, 100 * e_el, nodal.fem * 1e3, 100 * e_no);
+    EXPECT_LT(e_no, e0 + 0.05) << "nu " << nu;
+    EXPECT_LT(e_no, e_el) << "nu " << nu;
+  }
+  // The element form's locking grows without bound as nu -> 0.5; the nodal form's error does not.
+  const Sag locked = cantilever_tip_sag(40, 4, 0.4999, VolumeForm::Element);
+  EXPECT_LT(locked.fem, 0.5 * locked.exact);
 }
 
 namespace {

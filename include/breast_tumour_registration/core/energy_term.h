@@ -30,6 +30,9 @@ class EnergyTerm {
   virtual void add_gradient(const Points& x, Eigen::VectorXd& g) const = 0;
   /// Adds d2E/dx2 into H; with project_psd, each local block is made PSD first.
   virtual void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const = 0;
+  /// Vertex groups whose blocks add_hessian fills beyond those of shared tetrahedra (the
+  /// assembler's pattern must include them); most terms need none.
+  virtual std::vector<std::vector<int>> hessian_cliques() const { return {}; }
   /// Appends the low-rank part subtracted from add_hessian's matrix; most terms have none.
   virtual void add_low_rank_hessian(const Points& /*x*/, std::vector<LowRankHessian>& /*parts*/) const {}
 };

@@ -5,6 +5,7 @@
 
 #include <vector>
 
+#include "breast_tumour_registration/core/elastic_energy.h"
 #include "breast_tumour_registration/core/newton_solver.h"
 #include "breast_tumour_registration/core/stable_neo_hookean.h"
 
@@ -19,6 +20,7 @@ struct GravityProblem {
   Vec3 gravity = Vec3(0, 0, -9.81);   ///< [m/s^2]
   std::vector<int> inclusion;         ///< tetrahedra with their own Young's modulus (e.g. a stiff tumour)
   double inclusion_youngs_modulus = 0;  ///< [Pa], same Poisson's ratio
+  VolumeForm volume_form = VolumeForm::Auto;  ///< see elastic_energy.h
 };
 
 struct GravityResult {

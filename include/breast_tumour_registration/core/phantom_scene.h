@@ -3,6 +3,8 @@
 // ready for load_scene. Used by btr_phantom, the tests and the experiments.
 #pragma once
 
+#include "breast_tumour_registration/core/elastic_energy.h"
+
 #include <functional>
 #include <map>
 #include <string>
@@ -18,6 +20,7 @@ struct PhantomSceneOptions {
   double youngs_modulus = 3400;  ///< generating material [Pa]
   double poisson_ratio = 0.49;
   double density = 1000;
+  VolumeForm volume_form = VolumeForm::Auto;  ///< of the generating material (elastic_energy.h)
   LengthUnit units = LengthUnit::Millimetre;
   std::string landmark_set = "C+O";
   /// > 0: the tumours' elements get this Young's modulus when generating prone and supine

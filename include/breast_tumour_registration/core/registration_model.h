@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "breast_tumour_registration/core/elastic_energy.h"
 #include "breast_tumour_registration/core/embedding.h"
 #include "breast_tumour_registration/core/newton_solver.h"
 #include "breast_tumour_registration/core/stable_neo_hookean.h"
@@ -18,6 +19,7 @@ struct MaterialParameters {
   double youngs_modulus = 3400;  ///< [Pa] (thesis: Hipwell et al. 2016)
   double poisson_ratio = 0.49;
   double density = 1000;         ///< [kg/m^3]
+  VolumeForm volume_form = VolumeForm::Auto;  ///< element or nodal volume term (elastic_energy.h)
 };
 
 struct EmbeddedTumour {
@@ -34,6 +36,7 @@ struct RegistrationModel {
   std::vector<StableNeoHookean> materials;
   std::vector<int> material_of;    ///< per tetrahedron
   MaterialParameters material;
+  VolumeForm volume_form = VolumeForm::Element;  ///< resolved from material (never Auto)
   double volume = 0;               ///< [m^3]
   Vec3 gravity = Vec3(0, 0, -9.81);///< supine gravity in the model frame [m/s^2]
   std::vector<EmbeddedTumour> tumours;
@@ -51,6 +54,9 @@ int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceM
 /// Gives the tetrahedra whose centroid lies inside any tumour the material with Young's
 /// modulus `youngs_modulus` (same nu); addresses the thesis's flattened tumours (Ch. 6).
 void stiffen_tumours(RegistrationModel& model, double youngs_modulus);
+
+/// The model's elastic energy (material, volume form) added to `energy`: what every step simulates.
+void add_model_elastic_energy(TotalEnergy& energy, const RegistrationModel& model);
 
 /// Progress of a running step: step name and iteration; return false to abort.
 using StepCallback = std::function<bool(const std::string& step, const IterationInfo& it)>;

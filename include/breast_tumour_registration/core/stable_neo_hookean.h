@@ -34,6 +34,14 @@ class StableNeoHookean {
   /// From the classical Lame parameters (mu > 0, lambda >= 0).
   static StableNeoHookean from_lame(double mu, double lambda_lame);
 
+  /// The same material without its volume term lambda/2 (J - 1)^2: psi = mu/2 (I_C - 3) - mu (J - 1).
+  /// With NodalVolumeEnergy carrying the volume term on nodal averages (near-incompressible tissue).
+  StableNeoHookean shear_part() const {
+    StableNeoHookean m = *this;
+    m.lambda_ = 0;
+    return m;
+  }
+
   double mu() const { return mu_; }          ///< shear modulus [Pa]
   double lambda() const { return lambda_; }  ///< SNH volume stiffness lambda_L + mu [Pa]
 

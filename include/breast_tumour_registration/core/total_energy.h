@@ -14,6 +14,8 @@ class TotalEnergy {
   const std::vector<std::shared_ptr<const EnergyTerm>>& terms() const { return terms_; }
 
   double value(const Points& x) const;
+  /// Every term's hessian_cliques() followed by `extra`: what the assembler's pattern needs.
+  std::vector<std::vector<int>> hessian_cliques(std::vector<std::vector<int>> extra = {}) const;
   /// Full 3#V gradient.
   Eigen::VectorXd gradient(const Points& x) const;
   /// Zeroes H and assembles every term into it.
