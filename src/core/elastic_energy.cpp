@@ -84,27 +84,6 @@ void ElasticEnergy::add_hessian(const Points& x, bool project_psd, HessianAssemb
   }
 }
 
-VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio) {
-  if (form != VolumeForm::Auto) return form;
-  return poisson_ratio >= kNodalVolumeFromPoisson ? VolumeForm::Nodal : VolumeForm::Element;
-}
-
-VolumeForm parse_volume_form(const std::string& s) {
-  if (s == "auto") return VolumeForm::Auto;
-  if (s == "element") return VolumeForm::Element;
-  if (s == "nodal") return VolumeForm::Nodal;
-  throw InputError("volume form '" + s + "': expected auto, element or nodal");
-}
-
-const char* to_string(VolumeForm form) {
-  switch (form) {
-    case VolumeForm::Auto: return "auto";
-    case VolumeForm::Element: return "element";
-    case VolumeForm::Nodal: return "nodal";
-  }
-  return "?";
-}
-
 void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vector<StableNeoHookean>& materials,
                         const std::vector<int>& material_of, VolumeForm form) {
   if (form == VolumeForm::Auto) throw InputError("add_elastic_energy: resolve the volume form first");

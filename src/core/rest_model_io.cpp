@@ -120,9 +120,9 @@ PhantomModel load_rest_model_fields(const std::string& path) {
     }
     return 0;
   });
-  for (const auto& [name, t] : m.tumours)  // every tumour point inside the rest mesh
-    c.load("tumours." + name, [&] {
-      embed_points(m.rest, t.V, OutsidePolicy::Error);
+  for (const auto& tumour : m.tumours)  // every tumour point inside the rest mesh
+    c.load("tumours." + tumour.first, [&] {
+      embed_points(m.rest, tumour.second.V, OutsidePolicy::Error);
       return 0;
     });
   return m;

@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/core/stable_neo_hookean.h"
 #include "breast_tumour_registration/core/tet_kinematics.h"
 #include "breast_tumour_registration/core/total_energy.h"
+#include "breast_tumour_registration/core/volume_form.h"
 
 namespace btr {
 
@@ -43,18 +44,6 @@ class ElasticEnergy : public EnergyTerm {
   mutable std::vector<long> strides_;  // 4 per tet
   mutable std::vector<Mat12> buffer_;
 };
-
-/// How the volume term lambda/2 (J - 1)^2 is integrated: per element (the thesis's linear
-/// tetrahedra, which lock as nu -> 0.5), or on nodal averages (NodalVolumeEnergy). Auto:
-/// nodal from kNodalVolumeFromPoisson up.
-enum class VolumeForm { Auto, Element, Nodal };
-/// Measured on a cantilever against beam theory and on the phantom (BENCHMARKS.md): below
-/// it the element form is as accurate and the figures of the thesis's nu = 0.49 stay as they were.
-constexpr double kNodalVolumeFromPoisson = 0.495;
-VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio);
-/// Parses "auto", "element" or "nodal"; InputError otherwise.
-VolumeForm parse_volume_form(const std::string& s);
-const char* to_string(VolumeForm form);
 
 /// Adds the stable Neo-Hookean energy of the materials to `energy`: one ElasticEnergy (Element
 /// form), or ElasticEnergy on their shear parts plus NodalVolumeEnergy (Nodal form). `form`

@@ -1,0 +1,25 @@
+// How the volume term of the stable Neo-Hookean energy is integrated (elastic_energy.h,
+// nodal_volume_energy.h): a choice the scene and the model files may state.
+#pragma once
+
+#include <string>
+
+namespace btr {
+
+/// How the volume term lambda/2 (J - 1)^2 is integrated: per element (the thesis's linear
+/// tetrahedra, which lock as nu -> 0.5), or on nodal averages (NodalVolumeEnergy). Auto:
+/// nodal from kNodalVolumeFromPoisson up.
+enum class VolumeForm { Auto, Element, Nodal };
+/// Measured (BENCHMARKS.md): the nodal form is the more accurate in bending at every nu from
+/// 0.45 to 0.4999 (a cantilever against beam theory) and on the phantom from nu = 0.499 up, and
+/// it makes a registration 2 to 4 times slower (its Hessian couples each vertex's patch). The
+/// threshold keeps the thesis's nu = 0.49 on the faster element form, whose phantom figures
+/// (truth made by the same form) stay as they were; `material.volume_form: nodal` chooses the
+/// locking-free form at any nu.
+constexpr double kNodalVolumeFromPoisson = 0.495;
+VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio);
+/// Parses "auto", "element" or "nodal"; InputError otherwise.
+VolumeForm parse_volume_form(const std::string& s);
+const char* to_string(VolumeForm form);
+
+}  // namespace btr
