@@ -4,7 +4,9 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <sys/wait.h>
 
@@ -56,4 +58,24 @@ TEST(Tools, SceneMistakesAndAnUnwritableOutputExitWithCode2BeforeWork) {
   btr::test::write_text(d + "/blocker", "a file where a folder should be");
   expect_refused("btr_register " + d + "/scene.yaml --out " + d + "/blocker/out", "--out '" + d + "/blocker/out'");
   EXPECT_EQ(run("btr_register --help").code, 0);
+}
+
+// Issue 11: a registration that ends far from its own data (here a model a million times too
+// stiff for its landmarks) exits with code 5 and says why; the same scene with its own E exits 0.
+TEST(Tools, AnImplausibleResultExitsWithCode5) {
+  const std::string d = btr::test::temp_dir();
+  ASSERT_EQ(run("btr_phantom -q --cell-size 14 --out " + d).code, 0);
+  const auto sane = run("btr_register " + d + "/scene.yaml -q --preset fast --out " + d + "/sane");
+  EXPECT_EQ(sane.code, 0) << sane.output;
+  std::ifstream in(d + "/scene.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const size_t at = yaml.find("youngs_modulus: 3400");
+  ASSERT_NE(at, std::string::npos) << yaml;
+  yaml.replace(at, 20, "youngs_modulus: 3.4e9");
+  btr::test::write_text(d + "/stiff.yaml", yaml);
+  const auto stiff = run("btr_register " + d + "/stiff.yaml -q --preset fast --out " + d + "/stiff");
+  EXPECT_EQ(stiff.code, 5) << stiff.output;
+  EXPECT_NE(stiff.output.find("implausible result: a landmark ends"), std::string::npos) << stiff.output;
 }
