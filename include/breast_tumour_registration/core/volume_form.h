@@ -12,7 +12,7 @@ namespace btr {
 enum class VolumeForm { Auto, Element, Nodal };
 /// Measured (BENCHMARKS.md): the nodal form is the more accurate in bending at every nu from
 /// 0.45 to 0.4999 (a cantilever against beam theory) and on the phantom from nu = 0.499 up, and
-/// it makes a registration 2 to 4 times slower (its Hessian couples each vertex's patch). The
+/// it makes a registration 2.5 to 4.5 times slower (its Hessian couples each vertex's patch). The
 /// threshold keeps the thesis's nu = 0.49 on the faster element form, whose phantom figures
 /// (truth made by the same form) stay as they were; `material.volume_form: nodal` chooses the
 /// locking-free form at any nu.
