@@ -55,33 +55,11 @@ void ElasticEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const {
 
 void ElasticEnergy::add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const {
   const Eigen::Index nt = T_.rows();
-  if (cached_for_ != H.id()) {
-    offsets_.assign(16 * nt, -1);
-    strides_.assign(4 * nt, 0);
-    for (Eigen::Index t = 0; t < nt; ++t)
-      for (int b = 0; b < 4; ++b) {
-        if (!H.is_fixed(T_(t, b))) strides_[4 * t + b] = H.column_stride(T_(t, b));
-        for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T_(t, a), T_(t, b));
-      }
-    buffer_.resize(nt);
-    cached_for_ = H.id();
-  }
+  if (!scatter_.built_for(H)) scatter_.build(H, T_);
+  buffer_.resize(nt);
 #pragma omp parallel for schedule(static)
   for (Eigen::Index t = 0; t < nt; ++t) buffer_[t] = element_hessian(x, t, project_psd);
-  double* values = H.values();
-  for (Eigen::Index t = 0; t < nt; ++t) {
-    const Mat12& He = buffer_[t];
-    for (int b = 0; b < 4; ++b) {
-      const long stride = strides_[4 * t + b];
-      for (int a = 0; a < 4; ++a) {
-        const long off = offsets_[16 * t + 4 * b + a];
-        if (off < 0) continue;
-        double* v = values + off;
-        for (int k = 0; k < 3; ++k)
-          for (int r = 0; r < 3; ++r) v[k * stride + r] += He(3 * a + r, 3 * b + k);
-      }
-    }
-  }
+  for (Eigen::Index t = 0; t < nt; ++t) scatter_.add(H, t, buffer_[t]);
 }
 
 void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vector<StableNeoHookean>& materials,

@@ -86,4 +86,29 @@ void HessianAssembler::scatter_add(const Eigen::VectorXd& reduced, double scale,
   for (int f = 0; f < num_free_; ++f) full.segment<3>(3 * free_vertex_[f]) += scale * reduced.segment<3>(3 * f);
 }
 
+void TetScatter::build(const HessianAssembler& H, const Tetrahedra& T) {
+  offsets_.assign(16 * T.rows(), -1);
+  strides_.assign(4 * T.rows(), 0);
+  for (Eigen::Index t = 0; t < T.rows(); ++t)
+    for (int b = 0; b < 4; ++b) {
+      if (!H.is_fixed(T(t, b))) strides_[4 * t + b] = H.column_stride(T(t, b));
+      for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T(t, a), T(t, b));
+    }
+  id_ = H.id();
+}
+
+void TetScatter::add(HessianAssembler& H, Eigen::Index t, const Mat12& K) const {
+  double* values = H.values();
+  for (int b = 0; b < 4; ++b) {
+    const long stride = strides_[4 * t + b];
+    for (int a = 0; a < 4; ++a) {
+      const long off = offsets_[16 * t + 4 * b + a];
+      if (off < 0) continue;
+      double* v = values + off;
+      for (int k = 0; k < 3; ++k)
+        for (int r = 0; r < 3; ++r) v[k * stride + r] += K(3 * a + r, 3 * b + k);
+    }
+  }
+}
+
 }  // namespace btr

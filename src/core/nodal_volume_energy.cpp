@@ -77,14 +77,7 @@ void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const 
 }
 
 void NodalVolumeEnergy::build_scatter(const HessianAssembler& H) const {
-  const Eigen::Index nt = T_.rows();
-  tet_offsets_.assign(16 * nt, -1);
-  tet_strides_.assign(4 * nt, 0);
-  for (Eigen::Index t = 0; t < nt; ++t)
-    for (int b = 0; b < 4; ++b) {
-      if (!H.is_fixed(T_(t, b))) tet_strides_[4 * t + b] = H.column_stride(T_(t, b));
-      for (int a = 0; a < 4; ++a) tet_offsets_[16 * t + 4 * b + a] = H.block_offset(T_(t, a), T_(t, b));
-    }
+  tet_scatter_.build(H, T_);
   patch_offset_.assign(patches_.size() + 1, 0);
   patch_stride_.assign(patches_.size() + 1, 0);
   for (size_t n = 0; n < patches_.size(); ++n) {
@@ -120,17 +113,8 @@ void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAs
     const Mat9 H9 = s * determinant_hessian(F);
     Ke[t] = tet_hessian_from_stress_hessian(project_psd ? clamp_to_psd(H9) : H9, rest_[t].Dm_inv, rest_[t].volume);
   }
+  for (Eigen::Index t = 0; t < nt; ++t) tet_scatter_.add(H, t, Ke[t]);
   double* values = H.values();
-  for (Eigen::Index t = 0; t < nt; ++t)
-    for (int b = 0; b < 4; ++b) {
-      const long stride = tet_strides_[4 * t + b];
-      for (int a = 0; a < 4; ++a) {
-        const long off = tet_offsets_[16 * t + 4 * b + a];
-        if (off < 0) continue;
-        for (int k = 0; k < 3; ++k)
-          for (int r = 0; r < 3; ++r) values[off + k * stride + r] += Ke[t](3 * a + r, 3 * b + k);
-      }
-    }
   // sum_n lambda_n / V_n a_n a_n^T, a_n = sum_{t at n} dv_t/dx / 4 over the patch of n.
   std::vector<Vec3> a;
   for (size_t n = 0; n < patches_.size(); ++n) {

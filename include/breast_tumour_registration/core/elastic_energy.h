@@ -38,10 +38,7 @@ class ElasticEnergy : public EnergyTerm {
   std::vector<TetRestData> rest_;
   std::vector<StableNeoHookean> materials_;
   std::vector<int> material_of_;
-  // Cached scatter map (block offsets into the assembler's values), built on first use.
-  mutable unsigned long cached_for_ = 0;  // HessianAssembler::id()
-  mutable std::vector<long> offsets_;  // 16 per tet, -1 where a vertex is fixed
-  mutable std::vector<long> strides_;  // 4 per tet
+  mutable TetScatter scatter_;  // built on first use per assembler
   mutable std::vector<Mat12> buffer_;
 };
 

@@ -58,4 +58,20 @@ class HessianAssembler {
   Eigen::SparseMatrix<double> H_;
 };
 
+/// Where every tetrahedron's 4 x 4 vertex blocks sit in one assembler's values, so that element
+/// terms scatter their 12 x 12 matrices without a pattern look-up per block. Built once per
+/// assembler (HessianAssembler::id()); ElasticEnergy and NodalVolumeEnergy keep one each.
+class TetScatter {
+ public:
+  bool built_for(const HessianAssembler& H) const { return id_ == H.id(); }
+  void build(const HessianAssembler& H, const Tetrahedra& T);
+  /// Adds K (12 x 12, vertex blocks in T.row(t) order) to H; blocks of fixed vertices are dropped.
+  void add(HessianAssembler& H, Eigen::Index t, const Mat12& K) const;
+
+ private:
+  unsigned long id_ = 0;
+  std::vector<long> offsets_;  // 16 per tet, -1 where a vertex is fixed
+  std::vector<long> strides_;  // 4 per tet
+};
+
 }  // namespace btr

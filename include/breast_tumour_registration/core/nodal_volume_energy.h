@@ -49,12 +49,13 @@ class NodalVolumeEnergy : public EnergyTerm {
   Eigen::VectorXd lambda_n_;
   std::vector<std::vector<int>> patches_;    // per vertex: sorted vertices of its tetrahedra (empty: none)
   std::vector<std::vector<int>> tets_of_;    // per vertex: its tetrahedra
-  // Scatter map into the assembler's values, built on first use per assembler (as ElasticEnergy's):
-  // for tetrahedron t, 16 block offsets and 4 column strides; for vertex n, |patch|^2 offsets
-  // (from patch_offset_[n]) and |patch| strides (from patch_stride_[n]). -1: a fixed vertex.
+  // Scatter maps into the assembler's values, built on first use per assembler: the element
+  // blocks, and for vertex n |patch|^2 block offsets (from patch_offset_[n]) and |patch| column
+  // strides (from patch_stride_[n]); -1: a fixed vertex.
   void build_scatter(const HessianAssembler& H) const;
+  mutable TetScatter tet_scatter_;
   mutable unsigned long cached_for_ = 0;
-  mutable std::vector<long> tet_offsets_, tet_strides_, patch_offsets_, patch_strides_;
+  mutable std::vector<long> patch_offsets_, patch_strides_;
   mutable std::vector<size_t> patch_offset_, patch_stride_;
 };
 
