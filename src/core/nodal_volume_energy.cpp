@@ -55,6 +55,12 @@ Eigen::VectorXd NodalVolumeEnergy::nodal_volume_ratios(const Points& x) const {
   return J;
 }
 
+double NodalVolumeEnergy::element_pressure(const Eigen::VectorXd& J, Eigen::Index t) const {
+  double s = 0;
+  for (int a = 0; a < 4; ++a) s += lambda_n_[T_(t, a)] * (J[T_(t, a)] - 1) / 4;
+  return s;
+}
+
 double NodalVolumeEnergy::value(const Points& x) const {
   const Eigen::VectorXd J = nodal_volume_ratios(x);
   double e = 0;
@@ -67,8 +73,7 @@ void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const 
   // dE/dx = sum_t s_t dv_t/dx, s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4.
   const Eigen::VectorXd J = nodal_volume_ratios(x);
   for (Eigen::Index t = 0; t < T_.rows(); ++t) {
-    double s = 0;
-    for (int a = 0; a < 4; ++a) s += lambda_n_[T_(t, a)] * (J[T_(t, a)] - 1) / 4;
+    const double s = element_pressure(J, t);
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
     const Vec12 gt = tet_gradient_from_stress(s * Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
@@ -93,11 +98,10 @@ void NodalVolumeEnergy::build_scatter(const HessianAssembler& H) const {
       for (size_t i = 0; i < p.size(); ++i) patch_offsets_[patch_offset_[n] + j * p.size() + i] = H.block_offset(p[i], p[j]);
     }
   }
-  cached_for_ = H.id();
 }
 
 void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const {
-  if (cached_for_ != H.id()) build_scatter(H);
+  if (!tet_scatter_.built_for(H)) build_scatter(H);
   const Eigen::VectorXd J = nodal_volume_ratios(x);
   const Eigen::Index nt = T_.rows();
   // dv_t/dx per tetrahedron (12-vectors), for the rank-one patch terms.
@@ -108,9 +112,7 @@ void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAs
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
     dv[t] = tet_gradient_from_stress(Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
-    double s = 0;
-    for (int a = 0; a < 4; ++a) s += lambda_n_[T_(t, a)] * (J[T_(t, a)] - 1) / 4;
-    const Mat9 H9 = s * determinant_hessian(F);
+    const Mat9 H9 = element_pressure(J, t) * determinant_hessian(F);
     Ke[t] = tet_hessian_from_stress_hessian(project_psd ? clamp_to_psd(H9) : H9, rest_[t].Dm_inv, rest_[t].volume);
   }
   for (Eigen::Index t = 0; t < nt; ++t) tet_scatter_.add(H, t, Ke[t]);

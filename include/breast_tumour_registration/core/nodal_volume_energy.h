@@ -41,6 +41,8 @@ class NodalVolumeEnergy : public EnergyTerm {
   Eigen::VectorXd nodal_volume_ratios(const Points& x) const;
 
  private:
+  /// s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 [Pa]: the tetrahedron's share of its nodes' pressures.
+  double element_pressure(const Eigen::VectorXd& Jbar, Eigen::Index t) const;
   /// v_t = V_t J_t of every tetrahedron at x.
   Eigen::VectorXd element_volumes(const Points& x) const;
   Tetrahedra T_;
@@ -53,8 +55,7 @@ class NodalVolumeEnergy : public EnergyTerm {
   // blocks, and for vertex n |patch|^2 block offsets (from patch_offset_[n]) and |patch| column
   // strides (from patch_stride_[n]); -1: a fixed vertex.
   void build_scatter(const HessianAssembler& H) const;
-  mutable TetScatter tet_scatter_;
-  mutable unsigned long cached_for_ = 0;
+  mutable TetScatter tet_scatter_;  // its assembler id also marks the patch maps as current
   mutable std::vector<long> patch_offsets_, patch_strides_;
   mutable std::vector<size_t> patch_offset_, patch_stride_;
 };
