@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/core/experiment_suite.h"
 
 #include <chrono>
+#include <map>
 #include <cmath>
 #include <iomanip>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/experiment_shards.h"
 #include "breast_tumour_registration/core/registration_pipeline.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 
@@ -92,9 +94,9 @@ std::vector<ExperimentRun> plan_experiments(const ExperimentSuiteOptions& opt) {
     }
   }
   if (wanted("rest_shape")) {  // Sec. 5.2.3, Fig. 5.5
-    for (const bool rest : {false, true}) {
-      ExperimentRun r = base("rest_shape", "full", "rest_shape", rest ? "rest" : "prone");
-      r.rest_as_rest_shape = rest;
+    for (const char* shape : {"prone", "rest", "unloaded", "estimated"}) {
+      ExperimentRun r = base("rest_shape", "full", "rest_shape", shape);
+      r.rest_shape = shape;
       runs.push_back(r);
     }
   }
@@ -130,6 +132,7 @@ std::vector<ExperimentRun> plan_experiments(const ExperimentSuiteOptions& opt) {
     for (double e : es) {
       ExperimentRun r = base("material", "full", "method_youngs_modulus_Pa", format_value(e));
       r.method_youngs_modulus = e;
+      r.fixed_material = true;
       runs.push_back(r);
     }
   }
@@ -154,12 +157,18 @@ std::vector<ExperimentRun> plan_experiments(const ExperimentSuiteOptions& opt) {
 }
 
 Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& conf, const ExperimentRun& run,
-                       const std::string& preset) {
+                       const std::string& preset, const std::string& default_rest_shape) {
+  std::string shape = run.rest_shape.empty() ? default_rest_shape : run.rest_shape;
+  if (shape == "estimated" && run.fixed_material) shape = "unloaded";
+  if (shape != "prone" && shape != "rest" && shape != "unloaded" && shape != "estimated")
+    throw InputError("experiment rest_shape '" + shape + "' (prone, rest, unloaded, estimated)");
+  const bool true_rest = shape == "rest";
   Scene s;
   s.path = "experiment " + run.experiment + " (" + run.setting + ", " + run.variable + " = " + run.value + ")";
   s.units = LengthUnit::Metre;
   s.prone = model.rest;
-  if (!run.rest_as_rest_shape) s.prone.V = conf.prone;
+  if (!true_rest) s.prone.V = conf.prone;
+  if (shape == "unloaded" || shape == "estimated") s.prone_gravity = model.prone_gravity;
   s.chest_wall = model.chest_wall;
   const auto names = landmark_names(model, run.landmark_set);
   s.landmark_supine.resize(static_cast<long>(names.size()), 3);
@@ -178,11 +187,12 @@ Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& c
   for (const auto& [name, rest_tumour] : model.tumours) {
     SceneTumour t;
     t.name = name;
-    t.prone = run.rest_as_rest_shape ? rest_tumour : conf.tumour_prone.at(name);
+    t.prone = true_rest ? rest_tumour : conf.tumour_prone.at(name);
     t.supine_ground_truth = conf.tumour_supine.at(name);
     s.tumours.push_back(t);
   }
   s.material.youngs_modulus = run.method_youngs_modulus;
+  if (shape == "estimated") s.youngs_modulus_range = std::array<double, 2>{150, 24000};
   const Rigid g = misalignment_from_degrees_mm(run.gravity_rotation_deg, Vec3::Zero());
   s.gravity = g.linear() * model.supine_gravity;
   s.steps = run.steps;
@@ -194,7 +204,7 @@ Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& c
 
 void write_experiment_csv_header(std::ostream& out) {
   out << "experiment,setting,variable,value,generating_youngs_modulus_Pa,tumour,centroid_distance_mm,hausdorff_mm,"
-         "volume_ratio,seconds,landmark_residual_max_mm,skin_distance_mean_mm,status\n";
+         "volume_ratio,seconds,landmark_residual_max_mm,skin_distance_mean_mm,estimated_youngs_modulus_Pa,status\n";
 }
 
 void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row) {
@@ -204,7 +214,8 @@ void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row) {
   out << row.run->experiment << ',' << row.run->setting << ',' << row.run->variable << ',' << row.run->value << ','
       << row.generating_youngs_modulus << ',' << row.tumour << ',' << std::setprecision(6) << row.centroid_distance_mm
       << ',' << row.hausdorff_mm << ',' << row.volume_ratio << ',' << std::setprecision(4) << row.seconds << ','
-      << row.landmark_residual_max_mm << ',' << row.skin_distance_mean_mm << ',' << status << '\n';
+      << row.landmark_residual_max_mm << ',' << row.skin_distance_mean_mm << ',' << std::setprecision(5)
+      << row.estimated_youngs_modulus << ',' << status << '\n';
 }
 
 void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,
@@ -226,7 +237,12 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
   }
   const std::vector<double>& moduli = opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli;
   const RegistrationOptions preset = preset_options(opt.preset);
-  for (double e : moduli) {
+  // This share of the (modulus, run) items, in plan order.
+  const ShardRange share = shard_range(moduli.size() * todo.size(), opt.shard, opt.shards);
+  for (size_t ei = 0; ei < moduli.size(); ++ei) {
+    const double e = moduli[ei];
+    const size_t first_item = ei * todo.size();
+    if (first_item + todo.size() <= share.first || first_item >= share.last) continue;  // nothing of this modulus here
     PhantomSceneOptions gen;
     gen.youngs_modulus = e;
     gen.poisson_ratio = opt.poisson_ratio;
@@ -242,7 +258,10 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
     say("generated E = " + format_value(e) + " Pa in " +
         format_value(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) + " s" +
         (generation_failure.empty() ? "" : " (" + generation_failure + ")"));
-    for (const ExperimentRun* run : todo) {
+    std::map<double, std::pair<Points, StepReport>> unloaded;  // per method Young's modulus, this configuration
+    for (size_t ri = 0; ri < todo.size(); ++ri) {
+      if (first_item + ri < share.first || first_item + ri >= share.last) continue;
+      const ExperimentRun* run = todo[ri];
       ExperimentRow row;
       row.run = run;
       row.generating_youngs_modulus = e;
@@ -250,9 +269,30 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
       std::string failure = generation_failure;
       if (failure.empty()) {
         try {
-          const Scene scene = experiment_scene(model, conf, *run, opt.preset);
+          const Scene scene = experiment_scene(model, conf, *run, opt.preset,
+                                               !opt.unload ? "prone" : opt.estimate_stiffness ? "estimated" : "unloaded");
           std::vector<std::string> warnings;
-          const RegistrationModel rm = prepare_model(scene, warnings);
+          // The unloaded shape depends on the configuration and the method's material only:
+          // estimated once per both, then reused (its time still counts in every run's seconds).
+          Scene without_unload = scene;
+          without_unload.prone_gravity.reset();
+          RegistrationModel rm = prepare_model(without_unload, warnings);
+          double unload_seconds = 0;
+          if (scene.prone_gravity && !scene.youngs_modulus_range) {
+            auto it = unloaded.find(run->method_youngs_modulus);
+            if (it == unloaded.end()) {
+              const StepReport u = unload_model(rm, *scene.prone_gravity);
+              it = unloaded.emplace(run->method_youngs_modulus, std::make_pair(rm.rest.V, u)).first;
+              say("unloaded shape for method E = " + format_value(run->method_youngs_modulus) + " Pa: " +
+                  (u.converged ? "converged" : "not converged") + " (" + u.stop_reason + "), rest shape moved up to " +
+                  format_value(u.unload_rest_change * 1e3) + " mm, re-simulated prone within " +
+                  format_value(u.unload_mismatch * 1e3) + " mm, " + format_value(u.seconds) + " s" +
+                  (u.note.empty() ? "" : "; " + u.note));
+            } else {
+              set_rest_shape(rm, it->second.first, it->second.second);
+            }
+            unload_seconds = it->second.second.seconds;
+          }
           RegistrationOptions ro = preset;
           ro.landmark.weight = run->landmark_weight;
           const RegistrationResult r = run_registration(scene, rm, ro);
@@ -270,7 +310,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
             row.landmark_residual_max_mm = r.landmark_residual_max * 1e3;
             row.skin_distance_mean_mm = r.skin_distance_mean * 1e3;
             row.volume_ratio = t.volume_ratio_to_truth;
-            row.seconds = r.seconds;
+            row.seconds = r.seconds + unload_seconds;
+            row.estimated_youngs_modulus = r.estimated_youngs_modulus;
             row.status = status;
             rows.push_back(row);
           }

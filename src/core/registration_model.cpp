@@ -34,6 +34,7 @@ RegistrationModel make_registration_model(const TetMesh& prone, const std::vecto
   m.material_of.assign(m.rest.T.rows(), 0);
   m.gravity = gravity;
   for (Eigen::Index t = 0; t < m.rest.T.rows(); ++t) m.volume += tet_signed_volume(m.rest.V, m.rest.T, t);
+  m.prone = m.rest.V;
   return m;
 }
 
@@ -42,7 +43,8 @@ int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceM
   EmbeddedTumour t;
   t.name = name;
   t.prone = tumour;
-  t.embedding = embed_points(model.rest, tumour.V, OutsidePolicy::NearestTetrahedron);
+  // Given on the prone image: embedded in the prone positions (the coordinates then hold for any).
+  t.embedding = embed_points(TetMesh{model.prone, model.rest.T}, tumour.V, OutsidePolicy::NearestTetrahedron);
   const int outside = static_cast<int>(t.embedding.outside.size());
   model.tumours.push_back(std::move(t));
   return outside;
@@ -59,7 +61,7 @@ void stiffen_tumours(RegistrationModel& model, double E) {
   std::fill(model.material_of.begin(), model.material_of.end(), 0);
   std::vector<const SurfaceMesh*> surfaces;
   for (const auto& t : model.tumours) surfaces.push_back(&t.prone);
-  const std::vector<int> inside = tetrahedra_inside(model.rest, surfaces);
+  const std::vector<int> inside = tetrahedra_inside(TetMesh{model.prone, model.rest.T}, surfaces);
   for (int e : inside) model.material_of[e] = 1;
   model.stiff_tetrahedra = static_cast<long>(inside.size());
 }

@@ -24,7 +24,7 @@ bool requested(const Scene& s, const char* step) {
 }
 /// Flags a result that its own data contradict (RegistrationOptions' plausibility bounds).
 void check_plausibility(const RegistrationModel& model, const RegistrationOptions& opt, RegistrationResult& r) {
-  const Vec3 extent = (model.rest.V.colwise().maxCoeff() - model.rest.V.colwise().minCoeff()).transpose();
+  const Vec3 extent = (model.prone.colwise().maxCoeff() - model.prone.colwise().minCoeff()).transpose();
   const double diagonal = extent.norm();
   const double lm_bound = std::max(opt.landmark_residual_bound, opt.landmark_residual_fraction * diagonal);
   // Only where the landmarks were constraints: without the landmark step their residual
@@ -89,6 +89,8 @@ std::string PlannedSteps::describe() const {
     if (!s.empty()) s += " + ";
     s += n;
   };
+  add(stiffness, "stiffness");  // both first: they prepare the model the other steps simulate
+  add(unload, "unload");
   add(rigid_landmarks, "rigid (landmarks)");
   add(rigid_icp, "rigid (ICP)");
   add(gravity, "gravity");
@@ -107,6 +109,17 @@ PlannedSteps plan_steps(const Scene& s) {
     p.rigid_icp = have_rigid;
     if (!auto_steps && !p.rigid_landmarks && !p.rigid_icp)
       throw InputError(where + "'rigid' needs >= 3 landmarks or both chest_ring and supine.chest_ring");
+  }
+  if (requested(s, "unload") && !s.prone_gravity)
+    throw InputError(where + "'unload' needs the field 'prone_gravity' (the gravity of the prone image)");
+  p.unload = s.prone_gravity.has_value();
+  if (s.youngs_modulus_range) {
+    if (!s.prone_gravity)
+      throw InputError(s.path + ": field 'material.youngs_modulus': 'estimate' needs the field 'prone_gravity'");
+    if (s.landmark_anchors.size() < 3)
+      throw InputError(s.path + ": field 'material.youngs_modulus': 'estimate' needs >= 3 landmarks, the scene has " +
+                       std::to_string(s.landmark_anchors.size()));
+    p.stiffness = true;
   }
   if (requested(s, "gravity")) p.gravity = true;
   if (auto_steps ? have_lm : requested(s, "landmarks")) {
@@ -132,7 +145,7 @@ std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOpti
   return with_simulation_mesh(scene, opt.simulation_cell_size);
 }
 
-RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings) {
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload) {
   RegistrationModel m = make_registration_model(scene.prone, scene.chest_wall, scene.material, scene.gravity);
   for (const auto& t : scene.tumours) {
     const int outside = add_tumour(m, t.name, t.prone);
@@ -147,16 +160,52 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
     if (m.stiff_tetrahedra == 0)
       warnings.push_back("tumour_material: no tetrahedron centroid lies inside a tumour; refine the mesh");
   }
+  // Last: it simulates with the final materials (a stiffer tumour included).
+  // Its note (a stop before converging) reaches the result's warnings with the step reports.
+  if (scene.prone_gravity && !scene.youngs_modulus_range) unload_model(m, *scene.prone_gravity, unload);
   return m;
 }
 
-RegistrationResult run_registration(const Scene& scene, const RegistrationModel& model, const RegistrationOptions& opt,
+RegistrationResult run_registration(const Scene& scene, const RegistrationModel& prepared, const RegistrationOptions& opt,
                                     const StepCallback& callback) {
   const auto t_start = Clock::now();
   RegistrationResult r;
   r.warnings = scene.warnings;
   r.steps = plan_steps(scene);
-  r.x = model.rest.V;
+  const bool unloaded_in_preparation = r.steps.unload && !r.steps.stiffness;
+  if (unloaded_in_preparation != prepared.unload.has_value())
+    throw InputError(unloaded_in_preparation ? "the scene gives prone_gravity but the model was prepared without the unload step"
+                                             : "the model was unloaded but the scene does not ask for it here");
+  // 0. Stiffness (then the unload at it): on a copy of the prepared model, which stays as it was.
+  std::optional<RegistrationModel> estimated;
+  if (r.steps.stiffness) {
+    StiffnessOptions so = opt.stiffness;
+    so.min_youngs_modulus = (*scene.youngs_modulus_range)[0];
+    so.max_youngs_modulus = (*scene.youngs_modulus_range)[1];
+    const StiffnessEstimate est =
+        estimate_stiffness(prepared, *scene.prone_gravity, scene.landmark_anchors, scene.landmark_supine, so);
+    estimated = prepared;
+    scale_stiffness(*estimated, est.scale);
+    set_rest_shape(*estimated, est.rest, unload_report(est.unload, prepared.prone));
+    StepReport rep;
+    rep.name = "stiffness";
+    rep.converged = est.converged;
+    rep.stop_reason = est.stop_reason;
+    rep.outer_iterations = static_cast<int>(est.evaluations.size());
+    rep.seconds = est.seconds - est.unload.seconds;  // the chosen candidate's unload is the unload step's
+    rep.stiffness_youngs_modulus = est.youngs_modulus;
+    rep.stiffness_misfit = est.misfit;
+    if (est.at_bound) rep.note = est.stop_reason;
+    r.reports.push_back(rep);
+    r.estimated_youngs_modulus = est.youngs_modulus;
+    r.stiffness_evaluations = est.evaluations;
+  }
+  const RegistrationModel& model = estimated ? *estimated : prepared;
+  // From the rest shape: stress-free, so every step travels rest -> supine only (from the prone
+  // shape over an unloaded rest, a soft breast would have to swing through prone -> supine).
+  // Without a deforming step the answer is the prone shape moved rigidly.
+  r.x = (r.steps.gravity || r.steps.landmarks || r.steps.surface) ? model.rest.V : model.prone;
+  if (model.unload) r.reports.push_back(*model.unload);  // done once, when the model was prepared
 
   // 1. Rigid alignment. Kabsch on the landmarks is only a first guess: the landmarks sit on
   // deforming skin, so their fit absorbs part of the breast's own sag. Where the landmark step
@@ -173,7 +222,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     lm_supine = scene.landmark_supine;
     lm_prone.resize(scene.landmark_anchors.size(), 3);
     for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
-      lm_prone.row(i) = scene.landmark_anchors[i].position(model.rest.V).transpose();
+      lm_prone.row(i) = scene.landmark_anchors[i].position(model.prone).transpose();
     T = kabsch(lm_supine, lm_prone);
   }
   const bool joint_pose = r.steps.rigid_landmarks && r.steps.landmarks;

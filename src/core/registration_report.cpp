@@ -77,7 +77,14 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
       << num(s.t_setup) << ", \"assembly\": " << num(s.t_assembly) << ", \"factorization\": " << num(s.t_factorization)
       << ", \"solve\": " << num(s.t_solve) << ", \"line_search\": " << num(s.t_line_search)
       << ", \"projection\": " << num(s.t_projection) << "}, \"factorizations\": " << s.factorizations
-      << ", \"pcg_iterations\": " << s.pcg_iterations << "}";
+      << ", \"pcg_iterations\": " << s.pcg_iterations;
+    if (s.name == "unload")
+      j << ", \"unload\": {\"resimulated_prone_mismatch_mm\": " << num(s.unload_mismatch * 1e3)
+        << ", \"rest_shape_change_mm\": " << num(s.unload_rest_change * 1e3)
+        << ", \"forward_solves\": " << s.outer_iterations
+        << ", \"forward_solve_equivalents\": " << num(s.unload_forward_solve_equivalents)
+        << ", \"load_steps\": " << s.unload_load_steps << ", \"note\": " << quote(s.note) << "}";
+    j << "}";
   }
   j << "\n  ],\n  \"tumours\": [";
   for (size_t i = 0; i < r.tumours.size(); ++i) {
@@ -137,7 +144,7 @@ std::vector<std::string> write_registration_outputs(const std::string& dir, cons
   std::ofstream(path("report.json")) << registration_report_json(scene, model, r, prepare_seconds);
 
   // Cross-section through the first tumour (or the model centre).
-  const SurfaceMesh prone_skin = transform_surface(to_supine, boundary_surface(model.rest));
+  const SurfaceMesh prone_skin = transform_surface(to_supine, boundary_surface(TetMesh{model.prone, model.rest.T}));
   // Registered outlines thick underneath, supine and ground truth thin on top, so that
   // both stay visible where they coincide.
   std::vector<Outline> outlines = {{&prone_skin, {130, 130, 130}, 2}, {&skin, {235, 60, 60}, 4}};

@@ -40,8 +40,8 @@ const std::vector<std::string> kSceneKeys = {
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
-    "material.youngs_modulus", "material.poisson_ratio", "material.density", "material.volume_form", "tumour_material",
-    "tumour_material.youngs_modulus", "gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
+    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "tumour_material",
+    "tumour_material.youngs_modulus", "gravity", "prone_gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
     "misalignment.translation_mm", "generator.*"};
 
 Scene load_scene_fields(const std::string& path);
@@ -254,7 +254,23 @@ Scene load_scene_fields(const std::string& path) {
 
   // Material, gravity, steps, preset.
   if (const YAML::Node m = root["material"]) {
-    if (m["youngs_modulus"]) s.material.youngs_modulus = c.number(m["youngs_modulus"], "material.youngs_modulus");
+    if (m["youngs_modulus"]) {
+      if (m["youngs_modulus"].IsScalar() && m["youngs_modulus"].Scalar() == "estimate") {
+        s.youngs_modulus_range = std::array<double, 2>{150, 24000};
+      } else {
+        s.material.youngs_modulus = c.number(m["youngs_modulus"], "material.youngs_modulus");
+      }
+    }
+    if (m["youngs_modulus_range"]) {
+      if (!s.youngs_modulus_range)
+        c.fail("material.youngs_modulus_range", "only with 'youngs_modulus: estimate'");
+      const YAML::Node r = m["youngs_modulus_range"];
+      if (!r.IsSequence() || r.size() != 2) c.fail("material.youngs_modulus_range", "expected [min, max] in Pa");
+      const double lo = c.number(r[0], "material.youngs_modulus_range"), hi = c.number(r[1], "material.youngs_modulus_range");
+      if (!(lo > 0) || !(hi > 1.5 * lo))
+        c.fail("material.youngs_modulus_range", "expected 0 < min < max / 1.5 [Pa]");
+      s.youngs_modulus_range = std::array<double, 2>{lo, hi};
+    }
     if (m["poisson_ratio"]) s.material.poisson_ratio = c.number(m["poisson_ratio"], "material.poisson_ratio");
     if (m["density"]) s.material.density = c.number(m["density"], "material.density");
     if (m["volume_form"])
@@ -274,13 +290,17 @@ Scene load_scene_fields(const std::string& path) {
                       "chest wall is the plane z = 0 and the breast points towards +z");
   s.gravity = c.vec3(root["gravity"], "gravity");
   if (!(s.gravity.norm() > 0)) c.fail("gravity", "must not be zero");
+  if (root["prone_gravity"]) {
+    s.prone_gravity = c.vec3(root["prone_gravity"], "prone_gravity");
+    if (!(s.prone_gravity->norm() > 0)) c.fail("prone_gravity", "must not be zero");
+  }
   if (const YAML::Node st = root["steps"]) {
     if (st.IsScalar() && c.text(st, "steps") == "auto") {
     } else if (st.IsSequence()) {
       for (const auto& n : st) {
         const std::string name = c.text(n, "steps");
-        if (name != "rigid" && name != "gravity" && name != "landmarks" && name != "surface")
-          c.fail("steps", "unknown step '" + name + "' (rigid, gravity, landmarks, surface)");
+        if (name != "rigid" && name != "unload" && name != "gravity" && name != "landmarks" && name != "surface")
+          c.fail("steps", "unknown step '" + name + "' (rigid, unload, gravity, landmarks, surface)");
         s.steps.push_back(name);
       }
       if (s.steps.empty()) c.fail("steps", "empty list; use 'auto' or name the steps");

@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/experiment_shards.h"
 #include "breast_tumour_registration/core/experiment_suite.h"
 #include "breast_tumour_registration/core/registration_pipeline.h"
 #include "breast_tumour_registration/core/rest_model_io.h"
@@ -40,15 +41,41 @@ int main(int argc, char** argv) {
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
   app.add_flag("--quick", quick, "a few values per experiment and two generating moduli (1000, 4000 Pa) unless -E");
   app.add_flag("-q,--quiet", quiet, "no progress lines");
+  std::string shard;
+  std::vector<std::string> merge;
+  app.add_option("--shard", shard,
+                 "K/N: run share K of N of the plan (contiguous blocks of its modulus x run items); the output folder "
+                 "gets shard.txt beside results.csv. Join the shares with --merge");
+  app.add_option("--merge", merge,
+                 "join the output folders of shares 1..N of one study into OUT/results.csv (checks that they belong "
+                 "together and that none is missing) and exit; runs nothing");
+  bool no_unload = false, estimate_stiffness = false;
+  app.add_flag("--estimate-stiffness", estimate_stiffness,
+               "also estimate the Young's modulus from the landmarks (the step 'stiffness'; not in the material "
+               "experiment, which sweeps it)");
+  app.add_flag("--no-unload", no_unload,
+               "the prone shape as the method's rest shape (the thesis); default: the unloaded shape estimated from it "
+               "under the model's prone gravity (the rest_shape experiment runs all three either way)");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   const auto t0 = std::chrono::steady_clock::now();
   try {
+    if (!merge.empty()) {
+      fs::create_directories(out_dir);
+      const std::string merged = (fs::path(out_dir) / "results.csv").string();
+      const long n = merge_experiment_shards(merge, merged);
+      std::printf("[experiments] merged %zu shares, %ld rows, into %s\n", merge.size(), n,
+                  fs::absolute(merged).string().c_str());
+      return 0;
+    }
     ExperimentSuiteOptions opt;
+    if (!shard.empty()) parse_shard(shard, opt.shard, opt.shards);
     opt.experiments = experiments;
     opt.generating_youngs_moduli = moduli;
     opt.quick = quick;
     opt.preset = preset;
+    opt.unload = !no_unload;
+    opt.estimate_stiffness = estimate_stiffness;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};
     preset_options(preset);  // validates the name before the expensive steps
     const std::vector<ExperimentRun> runs = plan_experiments(opt);
@@ -73,6 +100,9 @@ int main(int argc, char** argv) {
     std::ofstream csv(csv_path);
     if (!csv) throw InputError("cannot write '" + csv_path + "'");
     write_experiment_csv_header(csv);
+    if (opt.shards > 1)
+      write_shard_info(out_dir, opt.shard, opt.shards,
+                       plan_fingerprint(opt, runs, static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows())));
     long rows = 0, failed = 0;
     run_experiments(
         model, opt, runs,

@@ -5,10 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/experiment_shards.h"
 #include "breast_tumour_registration/core/experiment_suite.h"
 #include "breast_tumour_registration/core/index_io.h"
 #include "breast_tumour_registration/core/rest_model_io.h"
@@ -48,7 +51,7 @@ TEST(ExperimentPlan, CoversEveryValueOfTable51) {
   std::map<std::string, int> per;
   for (const auto& r : runs) ++per[r.experiment];
   EXPECT_EQ(per["practical"], 5);
-  EXPECT_EQ(per["rest_shape"], 2);
+  EXPECT_EQ(per["rest_shape"], 4);  // prone, true rest, unloaded, unloaded at an estimated E
   EXPECT_EQ(per["rotated_gravity"], 7);                   // 0, 2, ..., 10, 15 deg
   EXPECT_EQ(per["misalignment"], 2 * (7 + 7 + 11 + 11));  // rot X, rot Z, shift X, shift Z; with and without rigid
   EXPECT_EQ(per["material"], 16);
@@ -65,6 +68,7 @@ TEST(ExperimentPlan, CoversEveryValueOfTable51) {
 TEST(ExperimentSuite, QuickRunReproducesTheThesisFindings) {
   ExperimentSuiteOptions o;
   o.quick = true;
+  o.unload = false;  // the thesis's method: the prone shape as rest shape
   o.generating_youngs_moduli = {4000};
   const auto runs = plan_experiments(o);
   Summary s;
@@ -77,12 +81,12 @@ TEST(ExperimentSuite, QuickRunReproducesTheThesisFindings) {
   });
   EXPECT_EQ(s.rows, static_cast<int>(runs.size()) * 5);
   EXPECT_EQ(s.nonfinite, 0);
-  // One header and one line per row, thirteen fields each.
+  // One header and one line per row, fourteen fields each.
   std::istringstream lines(csv.str());
   std::string line;
   int n = 0;
   while (std::getline(lines, line)) {
-    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 12) << line;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 13) << line;
     ++n;
   }
   EXPECT_EQ(n, s.rows + 1);
@@ -208,4 +212,77 @@ TEST(RestModelErrors, NameTheFieldAtFault) {
 }
 
 }  // namespace
+}  // namespace btr
+
+namespace btr {
+namespace {
+
+// The CSV of a suite run with the seconds column (timing, never reproducible) blanked.
+std::string suite_csv(const ExperimentSuiteOptions& o, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream csv(dir + "/results.csv");
+  write_experiment_csv_header(csv);
+  run_experiments(coarse_phantom(), o, plan_experiments(o), [&](const ExperimentRow& r) {
+    ExperimentRow timeless = r;
+    timeless.seconds = 0;
+    write_experiment_csv_row(csv, timeless);
+  });
+  if (o.shards > 1)
+    write_shard_info(dir, o.shard, o.shards,
+                     plan_fingerprint(o, plan_experiments(o), static_cast<long>(coarse_phantom().rest.V.rows()),
+                                      static_cast<long>(coarse_phantom().rest.T.rows())));
+  csv.close();
+  std::ifstream in(dir + "/results.csv");
+  std::stringstream all;
+  all << in.rdbuf();
+  return all.str();
+}
+
+}  // namespace
+
+// Issue 13: a study cut into shares (each run anywhere) and merged is the study run in one go.
+TEST(ExperimentShards, MergedSharesEqualTheUnshardedSuite) {
+  ExperimentSuiteOptions o;
+  o.experiments = {"landmark_weight"};
+  o.quick = true;
+  o.generating_youngs_moduli = {3000, 5000};
+  const std::string base = test::temp_dir();
+  const std::string whole = suite_csv(o, base + "/whole");
+  std::vector<std::string> dirs;
+  for (int k = 3; k >= 1; --k) {  // any order
+    ExperimentSuiteOptions s = o;
+    s.shard = k;
+    s.shards = 3;
+    dirs.push_back(base + "/share" + std::to_string(k));
+    suite_csv(s, dirs.back());
+  }
+  const long rows = merge_experiment_shards(dirs, base + "/merged.csv");
+  std::ifstream in(base + "/merged.csv");
+  std::stringstream merged;
+  merged << in.rdbuf();
+  EXPECT_EQ(rows, 4 * 5);  // 2 runs x 2 moduli, 5 tumours each
+  EXPECT_EQ(merged.str(), whole);
+
+  // Shares that do not make one study are refused, naming what is wrong.
+  test::expect_throw_with<InputError>([&] { merge_experiment_shards({dirs[0], dirs[1]}, base + "/m.csv"); },
+                                      "share 1/3 is missing");
+  test::expect_throw_with<InputError>([&] { merge_experiment_shards({dirs[0], dirs[0], dirs[1], dirs[2]}, base + "/m.csv"); },
+                                      "given twice");
+  ExperimentSuiteOptions other = o;
+  other.generating_youngs_moduli = {3000, 6000};
+  other.shard = 1;
+  other.shards = 3;
+  suite_csv(other, base + "/other1");
+  test::expect_throw_with<InputError>(
+      [&] { merge_experiment_shards({base + "/other1", dirs[0], dirs[1]}, base + "/m.csv"); }, "another study");
+  test::expect_throw_with<InputError>([&] { merge_experiment_shards({base + "/whole"}, base + "/m.csv"); },
+                                      "not a shard file");
+  int k = 0, n = 0;
+  parse_shard("2/5", k, n);
+  EXPECT_EQ(k, 2);
+  EXPECT_EQ(n, 5);
+  test::expect_throw_with<InputError>([&] { parse_shard("6/5", k, n); }, "1 <= K <= N");
+  test::expect_throw_with<InputError>([&] { parse_shard("2-5", k, n); }, "expected K/N");
+}
+
 }  // namespace btr

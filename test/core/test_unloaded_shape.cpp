@@ -3,11 +3,13 @@
 // recover it from the prone shape alone.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/phantom.h"
 #include "breast_tumour_registration/core/phantom_scene.h"
+#include "breast_tumour_registration/core/tet_kinematics.h"
 #include "breast_tumour_registration/core/unloaded_shape.h"
 
 using namespace btr;
@@ -36,7 +38,7 @@ TEST_P(Unload, RecoversThePhantomsRestShapeFromItsProneShape) {
   pb.density = so.density;
   pb.gravity = model.prone_gravity;
   UnloadOptions opt;
-  opt.newton.gradient_rel_tolerance = 1e-9;
+  opt.forward.newton.gradient_rel_tolerance = 1e-9;
   const UnloadResult r = estimate_unloaded_shape(pb, opt);
   const double rest_error = max_row_norm(r.rest - model.rest.V), sag = max_row_norm(conf.prone - model.rest.V);
   std::printf("E %g Pa: prone sag %.1f mm; %s after %d forward solves (%.1f forward-solve equivalents, %.2f s); "
@@ -48,9 +50,9 @@ TEST_P(Unload, RecoversThePhantomsRestShapeFromItsProneShape) {
   EXPECT_LT(rest_error, 5e-4);
 }
 
-// At 200 Pa this coarse phantom sags 110 mm prone and neither the inverse-gravity solve nor the
-// forward solve from the prone shape converges in one load step (issue 13: load continuation).
-INSTANTIATE_TEST_SUITE_P(Phantom, Unload, ::testing::Values(3400.0, 1000.0, 400.0));
+// At 200 Pa this coarse phantom sags 110 mm prone: neither the inverse-gravity solve nor the
+// forward solve from the prone shape converges in one load step, and load continuation does it.
+INSTANTIATE_TEST_SUITE_P(Phantom, Unload, ::testing::Values(3400.0, 1000.0, 400.0, 200.0));
 
 TEST(Unload, BadInputIsRefused) {
   const TetMesh none;
@@ -59,4 +61,42 @@ TEST(Unload, BadInputIsRefused) {
   pb.loaded = &none;
   pb.volume_form = VolumeForm::Auto;
   EXPECT_THROW(estimate_unloaded_shape(pb), InputError);  // unresolved form
+}
+
+// Softer than anything that could have made the shape: the 200 Pa prone shape unloaded with a
+// 100 Pa material. It converges or stops with a reason; it never reports converged with a
+// mismatch above the tolerance, and it keeps an estimate no worse than its first.
+TEST(Unload, AtOneHundredPascalItConvergesOrSaysWhyNot) {
+  PhantomOptions po;
+  po.tet.cell_size = 0.012;
+  po.surface_rings = 12;
+  const PhantomModel model = make_phantom_model(po);
+  PhantomSceneOptions so;
+  so.youngs_modulus = 200;
+  const PhantomConfigurations conf = simulate_phantom(model, so);
+  const TetMesh prone{conf.prone, model.rest.T};
+  UnloadProblem pb;
+  pb.loaded = &prone;
+  pb.fixed = model.chest_wall;
+  pb.materials = {StableNeoHookean(100, so.poisson_ratio)};
+  pb.volume_form = resolve_volume_form(VolumeForm::Auto, so.poisson_ratio);
+  pb.gravity = model.prone_gravity;
+  UnloadOptions opt;
+  opt.forward.newton.gradient_rel_tolerance = 1e-9;
+  opt.max_iterations = 10;  // bounded: this test is about the verdict, not the cost
+  opt.max_stages = 4;
+  const UnloadResult r = estimate_unloaded_shape(pb, opt);
+  std::printf("E 100 Pa on the 200 Pa prone shape: %s (converged %d) after %d forward solves, %d load steps, %.1f s; "
+              "re-simulated prone within %.3f mm\n",
+              r.stop_reason.c_str(), r.converged, r.iterations, r.load_steps, r.seconds, r.max_mismatch * 1e3);
+  EXPECT_FALSE(r.stop_reason.empty());
+  if (r.converged) {
+    EXPECT_LT(r.max_mismatch, opt.tolerance);
+  } else if (r.mismatch_history.empty()) {  // nothing verified: no mismatch claimed, the loaded shape kept
+    EXPECT_TRUE(std::isinf(r.max_mismatch));
+    EXPECT_EQ(r.rest, prone.V);
+  } else {
+    EXPECT_LE(r.max_mismatch, r.mismatch_history.front());
+  }
+  EXPECT_EQ(count_inverted(r.rest, prone.T), 0);
 }

@@ -22,11 +22,16 @@ struct ExperimentRun {
   std::string variable;    ///< name of the swept variable (with its unit)
   std::string value;       ///< its value, as written in the CSV
   std::vector<std::string> steps;  ///< pipeline steps (empty: auto)
-  bool rest_as_rest_shape = false; ///< start from the true rest shape instead of the prone shape
+  /// The method's rest shape: "prone" (the prone shape, as the thesis), "rest" (the true rest
+  /// shape, known only in an experiment), "unloaded" (estimated from the prone shape: the
+  /// scene gives prone_gravity), "estimated" (unloaded at a Young's modulus estimated from the
+  /// landmarks: youngs_modulus: estimate) or "" (the suite's default, ExperimentSuiteOptions).
+  std::string rest_shape;
   Vec3 gravity_rotation_deg = Vec3::Zero();  ///< rotation of the method's gravity direction
   Vec3 misalignment_rotation_deg = Vec3::Zero();
   Vec3 misalignment_translation_mm = Vec3::Zero();
   double method_youngs_modulus = 3400;  ///< the registration's material [Pa]
+  bool fixed_material = false;          ///< the material is the swept variable: never estimated
   double landmark_weight = 1e4;         ///< [N/m]
   std::string landmark_set = "C+O";     ///< a phantom_landmark_set name, or "all" (every landmark of the model)
 };
@@ -37,6 +42,15 @@ struct ExperimentSuiteOptions {
   bool quick = false;                    ///< a few values per experiment (for tests)
   double poisson_ratio = 0.49, density = 1000;
   std::string preset = "balanced";
+  /// Runs without their own rest_shape setting estimate the unloaded shape (the scene gives the
+  /// model's prone gravity); false: the prone shape is the rest shape, as in the thesis.
+  bool unload = true;
+  /// With unload, those runs also estimate the Young's modulus (except the material experiment,
+  /// whose variable it is).
+  bool estimate_stiffness = false;
+  /// Run only share `shard` (1-based) of `shards`: a contiguous block of the (generating
+  /// modulus, run) items in plan order (experiment_shards.h merges the shares' CSVs).
+  int shard = 1, shards = 1;
 };
 
 /// The thesis's generating Young's moduli: 200, 400, ..., 1000, 2000, ..., 12000 Pa.
@@ -52,7 +66,7 @@ std::vector<ExperimentRun> plan_experiments(const ExperimentSuiteOptions& opt);
 /// the supine surface, landmarks and tumours of `conf`, with the run's misalignment,
 /// material, gravity, landmark set and steps applied.
 Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& conf, const ExperimentRun& run,
-                       const std::string& preset);
+                       const std::string& preset, const std::string& default_rest_shape = "unloaded");
 
 struct ExperimentRow {
   const ExperimentRun* run = nullptr;
@@ -60,6 +74,7 @@ struct ExperimentRow {
   std::string tumour;
   double centroid_distance_mm = 0, hausdorff_mm = 0, volume_ratio = 0, seconds = 0;
   double landmark_residual_max_mm = 0, skin_distance_mean_mm = 0;  ///< the figures the plausibility check reads
+  double estimated_youngs_modulus = 0;  ///< [Pa] when the run estimated it (else 0)
   std::string status;  ///< converged, "not_converged: step: reason ...", or "failed: message"; " (implausible)" appended when flagged
 };
 

@@ -11,7 +11,9 @@
 #include "breast_tumour_registration/core/landmark_step.h"
 #include "breast_tumour_registration/core/rigid_regions.h"
 #include "breast_tumour_registration/core/scene.h"
+#include "breast_tumour_registration/core/stiffness_step.h"
 #include "breast_tumour_registration/core/surface_step.h"
+#include "breast_tumour_registration/core/unload_step.h"
 
 namespace btr {
 
@@ -22,6 +24,7 @@ struct RegistrationOptions {
   LandmarkStepOptions landmark;
   SurfaceStepOptions surface;
   NewtonOptions gravity;  ///< gravity pre-step
+  StiffnessOptions stiffness;  ///< stiffness step (its range is the scene's)
   /// > 0: simulate on the prone model re-tetrahedralized at this cell size [m] when the
   /// scene's mesh is finer (see simulation_scene); 0: the scene's mesh as given.
   double simulation_cell_size = 0;
@@ -51,6 +54,8 @@ RegistrationOptions preset_options(const std::string& name);
 struct PlannedSteps {
   bool rigid_landmarks = false;  ///< Kabsch on >= 3 landmark pairs (first guess; the landmark step then solves the pose)
   bool rigid_icp = false;        ///< ICP on prone and supine rigid regions
+  bool stiffness = false;        ///< Young's modulus estimated from the data (youngs_modulus: estimate), before unload
+  bool unload = false;           ///< the rest shape is the unloaded shape estimated from the prone one (scene.prone_gravity)
   bool gravity = false;
   bool landmarks = false;
   bool surface = false;
@@ -60,7 +65,10 @@ struct PlannedSteps {
 /// Steps for the scene: `auto` (scene.steps empty) takes every step its inputs allow
 /// (rigid when it has >= 3 landmarks or both rigid regions; landmarks; surface). An
 /// explicit list is checked against the inputs; a missing input is an InputError naming
-/// the field.
+/// the field. `unload` is planned exactly when the scene gives prone_gravity, listed or not:
+/// it changes the model every other step simulates, not the data they fit. `stiffness` is
+/// planned exactly when the scene says `youngs_modulus: estimate`, and needs prone_gravity and
+/// >= 3 landmarks.
 PlannedSteps plan_steps(const Scene& scene);
 
 /// When opt.simulation_cell_size asks for a clearly coarser mesh than the scene's (mean edge
@@ -70,8 +78,11 @@ PlannedSteps plan_steps(const Scene& scene);
 std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt);
 
 /// Builds the registration model of a scene (material, tumours embedded, stiffer tumour if
-/// asked). `warnings` receives messages about tumour points outside the mesh.
-RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings);
+/// asked, and the unloaded rest shape when the scene gives prone_gravity: model.unload, whose
+/// report every run_registration result carries; with `youngs_modulus: estimate` the unload
+/// waits for the stiffness, and runs in run_registration). `warnings` receives messages about tumour
+/// points outside the mesh.
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload = {});
 
 struct TumourResult {
   std::string name;
@@ -101,6 +112,10 @@ struct RegistrationResult {
   std::string rigid_note;             ///< what the symmetry check found (empty: one pose fits)
   double pose_disagreement = 0;  ///< [m] ICP vs joint landmark pose, max over the rigid region (when both ran)
   double rigid_seconds = 0;
+  /// [Pa] the stiffness step's estimate (0: not estimated); the steps simulated with every
+  /// material scaled to it
+  double estimated_youngs_modulus = 0;
+  std::vector<std::pair<double, double>> stiffness_evaluations;  ///< (E [Pa], landmark misfit [m]) it tried
   std::vector<StepReport> reports;
   Points x;                 ///< deformed vertex positions, model frame
   double seconds = 0;       ///< all steps, rigid alignment included
@@ -116,7 +131,7 @@ struct RegistrationResult {
 
 /// Runs the planned steps. Throws InputError for inconsistent inputs and SolverError for
 /// numerical failure; a step that stops without converging sets `converged = false`.
-RegistrationResult run_registration(const Scene& scene, const RegistrationModel& model, const RegistrationOptions& opt,
+RegistrationResult run_registration(const Scene& scene, const RegistrationModel& prepared, const RegistrationOptions& opt,
                                     const StepCallback& callback = {});
 
 }  // namespace btr

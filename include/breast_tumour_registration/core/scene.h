@@ -14,13 +14,18 @@
 //     chest_ring: ring.obj         # optional: supine rigid region (for ICP)
 //   tumours: [{name: t1, prone: t1.obj, supine_ground_truth: t1_supine.obj}]
 //   material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}
+//                                  # youngs_modulus: estimate (with prone_gravity and >= 3 landmarks):
+//                                  # the step `stiffness` finds it, in youngs_modulus_range: [150, 24000]
 //   tumour_material: {youngs_modulus: 17000}   # optional: stiffer tumour
 //   gravity: [0, 0, -9.81]         # supine gravity in the prone model frame [m/s^2] (required)
-//   steps: auto                    # or a list of: rigid, gravity, landmarks, surface
+//   prone_gravity: [0, 0, 9.81]    # optional: the gravity the prone image was taken under, same
+//                                  # frame; given, the step `unload` estimates the stress-free shape
+//   steps: auto                    # or a list of: rigid, unload, gravity, landmarks, surface
 //   preset: balanced               # fast, balanced, accurate
 //   misalignment: {rotation_deg: [0, 0, 15], translation_mm: [0, 0, 0]}  # optional, experiments
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,7 +72,13 @@ struct Scene {
   std::vector<SceneTumour> tumours;
   MaterialParameters material;
   std::optional<double> tumour_youngs_modulus;
+  /// `youngs_modulus: estimate`: the range [Pa] the stiffness step searches (material.youngs_modulus
+  /// is then only the reference the other materials are given relative to).
+  std::optional<std::array<double, 2>> youngs_modulus_range;
   Vec3 gravity = Vec3(0, 0, -9.81);
+  /// The gravity of the prone image, model frame [m/s^2]: given, the unload step runs (the
+  /// model's rest shape becomes the estimated unloaded shape); absent, the prone shape is the rest shape.
+  std::optional<Vec3> prone_gravity;
   std::vector<std::string> steps;        ///< empty: auto
   std::string preset = "balanced";
   Rigid misalignment = Rigid::Identity();  ///< already applied to all supine data
