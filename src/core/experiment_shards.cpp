@@ -37,7 +37,7 @@ std::string plan_fingerprint(const ExperimentSuiteOptions& opt, const std::vecto
                              long model_vertices, long model_tetrahedra) {
   std::ostringstream s;
   s.precision(17);
-  s << opt.preset << '|' << opt.poisson_ratio << '|' << opt.density << '|' << opt.unload << opt.estimate_stiffness << '|'
+  s << opt.preset << '|' << opt.poisson_ratio << '|' << opt.density << '|' << opt.rest_shape << '|'
     << model_vertices << '|' << model_tetrahedra << '|';
   for (double e : opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli) s << e << ',';
   for (const auto& r : runs) s << '|' << r.experiment << ':' << r.setting << ':' << r.variable << '=' << r.value;

@@ -269,8 +269,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
       std::string failure = generation_failure;
       if (failure.empty()) {
         try {
-          const Scene scene = experiment_scene(model, conf, *run, opt.preset,
-                                               !opt.unload ? "prone" : opt.estimate_stiffness ? "estimated" : "unloaded");
+          const Scene scene = experiment_scene(model, conf, *run, opt.preset, opt.rest_shape);
           std::vector<std::string> warnings;
           // The unloaded shape depends on the configuration and the method's material only:
           // estimated once per both, then reused (its time still counts in every run's seconds).

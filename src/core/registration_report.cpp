@@ -44,6 +44,14 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
     << ",\n  \"mesh\": {\"vertices\": " << model.rest.V.rows() << ", \"tetrahedra\": " << model.rest.T.rows()
     << ", \"chest_wall_vertices\": " << model.chest_wall.size() << ", \"skin_vertices\": " << model.skin.size()
     << ", \"stiff_tumour_tetrahedra\": " << model.stiff_tetrahedra << "},\n";
+  if (r.steps.stiffness) {
+    j << "  \"stiffness\": {\"estimated_youngs_modulus_Pa\": " << num(r.estimated_youngs_modulus) << ", \"evaluations\": [";
+    for (size_t i = 0; i < r.stiffness_evaluations.size(); ++i)
+      j << (i ? ", " : "") << "{\"youngs_modulus_Pa\": " << num(r.stiffness_evaluations[i].first)
+        << ", \"landmark_misfit_mm\": "
+        << num(r.stiffness_evaluations[i].second * 1e3) << "}";
+    j << "]},\n";
+  }
   j << "  \"seconds\": {\"tetrahedralization\": " << num(scene.tetrahedralize_seconds)
     << ", \"prepare\": " << num(prepare_seconds) << ", \"rigid\": " << num(r.rigid_seconds);
   for (const auto& s : r.reports) j << ", " << quote(s.name) << ": " << num(s.seconds);

@@ -49,13 +49,13 @@ int main(int argc, char** argv) {
   app.add_option("--merge", merge,
                  "join the output folders of shares 1..N of one study into OUT/results.csv (checks that they belong "
                  "together and that none is missing) and exit; runs nothing");
-  bool no_unload = false, estimate_stiffness = false;
-  app.add_flag("--estimate-stiffness", estimate_stiffness,
-               "also estimate the Young's modulus from the landmarks (the step 'stiffness'; not in the material "
-               "experiment, which sweeps it)");
-  app.add_flag("--no-unload", no_unload,
-               "the prone shape as the method's rest shape (the thesis); default: the unloaded shape estimated from it "
-               "under the model's prone gravity (the rest_shape experiment runs all three either way)");
+  std::string rest_shape = "prone";
+  app.add_option("--rest-shape", rest_shape,
+                 "the method's rest shape in every experiment but rest_shape (which runs all four): prone (the "
+                 "thesis), unloaded (estimated from the prone shape at the method's E), estimated (unloaded at an E "
+                 "estimated from the landmarks; the material experiment keeps its E)")
+      ->check(CLI::IsMember({"prone", "unloaded", "estimated"}))
+      ->capture_default_str();
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -74,8 +74,7 @@ int main(int argc, char** argv) {
     opt.generating_youngs_moduli = moduli;
     opt.quick = quick;
     opt.preset = preset;
-    opt.unload = !no_unload;
-    opt.estimate_stiffness = estimate_stiffness;
+    opt.rest_shape = rest_shape;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};
     preset_options(preset);  // validates the name before the expensive steps
     const std::vector<ExperimentRun> runs = plan_experiments(opt);

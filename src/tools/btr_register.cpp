@@ -98,8 +98,19 @@ int main(int argc, char** argv) {
                   r.rigid_seconds);
     if (!r.rigid_note.empty() && !r.rigid_pose_undecided) std::printf("[rigid   ] %s\n", r.rigid_note.c_str());
     for (const auto& s : r.reports) {
+      if (s.name == "stiffness") {
+        std::printf("[%-8s] E = %.0f Pa from %d candidates (landmark misfit of the gravity-only prediction %.3f mm): %s, in "
+                    "%.3f s\n",
+                    s.name.c_str(), s.stiffness_youngs_modulus, s.outer_iterations, s.stiffness_misfit * 1e3,
+                    s.stop_reason.c_str(), s.seconds);
+        continue;
+      }
+      const char* outer = s.name == "unload" ? " forward solves" : " projections";
       std::printf("[%-8s] %s: %d Newton iterations%s in %.3f s\n", s.name.c_str(), s.stop_reason.c_str(), s.iterations,
-                  s.outer_iterations ? (", " + std::to_string(s.outer_iterations) + " projections").c_str() : "", s.seconds);
+                  s.outer_iterations ? (", " + std::to_string(s.outer_iterations) + outer).c_str() : "", s.seconds);
+      if (s.name == "unload")
+        std::printf("[%-8s]   rest shape moved up to %.2f mm from the prone shape; re-simulated prone within %.4f mm\n",
+                    s.name.c_str(), s.unload_rest_change * 1e3, s.unload_mismatch * 1e3);
       std::printf("[%-8s]   setup %.3f, assembly %.3f, factorization %.3f (%d), solve %.3f (%d PCG iterations), "
                   "line search %.3f, projection %.3f s\n",
                   s.name.c_str(), s.t_setup, s.t_assembly, s.t_factorization, s.factorizations, s.t_solve, s.pcg_iterations,

@@ -25,7 +25,7 @@ struct ExperimentRun {
   /// The method's rest shape: "prone" (the prone shape, as the thesis), "rest" (the true rest
   /// shape, known only in an experiment), "unloaded" (estimated from the prone shape: the
   /// scene gives prone_gravity), "estimated" (unloaded at a Young's modulus estimated from the
-  /// landmarks: youngs_modulus: estimate) or "" (the suite's default, ExperimentSuiteOptions).
+  /// landmarks: youngs_modulus: estimate) or "" (the suite's default, ExperimentSuiteOptions::rest_shape).
   std::string rest_shape;
   Vec3 gravity_rotation_deg = Vec3::Zero();  ///< rotation of the method's gravity direction
   Vec3 misalignment_rotation_deg = Vec3::Zero();
@@ -42,12 +42,11 @@ struct ExperimentSuiteOptions {
   bool quick = false;                    ///< a few values per experiment (for tests)
   double poisson_ratio = 0.49, density = 1000;
   std::string preset = "balanced";
-  /// Runs without their own rest_shape setting estimate the unloaded shape (the scene gives the
-  /// model's prone gravity); false: the prone shape is the rest shape, as in the thesis.
-  bool unload = true;
-  /// With unload, those runs also estimate the Young's modulus (except the material experiment,
-  /// whose variable it is).
-  bool estimate_stiffness = false;
+  /// The rest shape of the runs without their own rest_shape setting: "prone" (the thesis's
+  /// method), "unloaded" (the scene states the model's prone gravity: unloaded at the method's
+  /// E) or "estimated" (also youngs_modulus: estimate; the material experiment, whose variable
+  /// E is, unloads at its E instead).
+  std::string rest_shape = "prone";
   /// Run only share `shard` (1-based) of `shards`: a contiguous block of the (generating
   /// modulus, run) items in plan order (experiment_shards.h merges the shares' CSVs).
   int shard = 1, shards = 1;
@@ -66,7 +65,7 @@ std::vector<ExperimentRun> plan_experiments(const ExperimentSuiteOptions& opt);
 /// the supine surface, landmarks and tumours of `conf`, with the run's misalignment,
 /// material, gravity, landmark set and steps applied.
 Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& conf, const ExperimentRun& run,
-                       const std::string& preset, const std::string& default_rest_shape = "unloaded");
+                       const std::string& preset, const std::string& default_rest_shape = "prone");
 
 struct ExperimentRow {
   const ExperimentRun* run = nullptr;
