@@ -1,0 +1,235 @@
+#!/usr/bin/python3
+"""Prone and supine truth made by a finite-element code we did not write (SfePy), for measuring
+the method on data its own solver did not generate (issue 13).
+
+The body is bench/make_shape_model.py's sheared, asymmetric half ellipsoid (no chest ring),
+meshed by TetGen and solved with quadratic tetrahedra (P2) in SfePy's total Lagrangian
+formulation: the decoupled neo-Hookean term (mu J^-2/3 (I1 - 3)) plus a bulk penalty
+K/2 (J - 1)^2, another hyperelastic law than the package's stable neo-Hookean with the same
+small-strain limit. The tissue is heterogeneous: fat, a fibroglandular core (an ellipsoid,
+2x the fat's E) and five spherical tumours (6x). Gravity is ramped up (adaptive load steps,
+Newton without line search) from the rest shape to the prone (+z) and the supine (-z)
+equilibrium with the chest wall (z = 0) fixed.
+
+For every fat modulus it writes OUT/E<fat E>/ with what a user of the package would have:
+the prone skin surface (prone.obj: the method meshes it itself, with CGAL), the chest-wall
+and landmark indices of that surface, the supine landmark positions, the supine skin surface,
+the prone tumours and their supine ground truth (tumour points carried by the P2 displacement
+field), and three scenes:
+  scene_prone.yaml      the thesis's method: the prone shape as rest shape, E = 3400 Pa assumed
+  scene_unloaded.yaml   prone_gravity given: unloaded at the assumed 3400 Pa
+  scene_estimated.yaml  prone_gravity and youngs_modulus: estimate
+and truth.json (moduli, sags, load steps, seconds).
+
+Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
+       [--max-volume 1500] [--poisson-ratio 0.49]   (needs Debian's python3-sfepy and tetgen)"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_shape_model import icosphere, surface, write_obj  # noqa: E402
+
+G = 9.81
+RHO = 1000.0
+
+
+def mesh_body(out, max_volume, a=60.0, bp=85.0, bm=70.0, c=65.0, s=15.0):
+    V, F, rings = surface(a, bp, bm, c, s)
+    off = os.path.join(out, 'body.off')
+    with open(off, 'w') as f:
+        f.write('OFF\n%d %d 0\n' % (len(V), len(F)))
+        f.writelines('%.9g %.9g %.9g\n' % tuple(v) for v in V)
+        f.writelines('3 %d %d %d\n' % tuple(t) for t in F)
+    subprocess.run(['tetgen', '-pq1.4a%g' % max_volume, '-zQ', off], check=True)
+    node = np.loadtxt(os.path.join(out, 'body.1.node'), comments='#', skiprows=1)[:, 1:4]
+    ele = np.loadtxt(os.path.join(out, 'body.1.ele'), comments='#', skiprows=1, dtype=int)[:, 1:5]
+    d = np.einsum('ij,ij->i', np.cross(node[ele[:, 1]] - node[ele[:, 0]], node[ele[:, 2]] - node[ele[:, 0]]),
+                  node[ele[:, 3]] - node[ele[:, 0]])
+    ele[d < 0] = ele[d < 0][:, [0, 2, 1, 3]]
+    ring = rings[len(rings) * 5 // 9]
+    n_phi = len(ring)
+    landmarks = {'C': 0, 'O1': ring[0], 'O2': ring[n_phi // 4], 'O3': ring[n_phi // 2], 'O4': ring[3 * n_phi // 4]}
+    tumours = {'central': (0, -0.15 * c, 0.45 * a), 'lateral': (0.45 * bp, 0, 0.3 * a), 'upper': (0, 0.5 * c, 0.25 * a),
+               'lower': (0, -0.55 * c, 0.2 * a), 'medial': (-0.5 * bm, 0.05 * c, 0.25 * a)}
+    gland = {'centre': np.array([0.0, -0.1 * c, 0.3 * a]), 'axes': np.array([0.55 * bp, 0.55 * c, 0.4 * a])}
+    return node, ele, landmarks, tumours, gland, (a, bp, bm, c, s)
+
+
+def labels(node, ele, tumours, gland, radius):
+    cen = node[ele].mean(axis=1)
+    lab = np.ones(len(ele), dtype=np.int32)  # 1 fat
+    lab[(((cen - gland['centre']) / gland['axes']) ** 2).sum(axis=1) < 1] = 2  # 2 gland
+    for p in tumours.values():
+        lab[np.linalg.norm(cen - np.array(p), axis=1) < radius] = 3  # 3 tumour
+    return lab
+
+
+def boundary(ele):
+    faces = np.concatenate([ele[:, [1, 2, 3]], ele[:, [0, 3, 2]], ele[:, [0, 1, 3]], ele[:, [0, 2, 1]]])
+    key = np.sort(faces, axis=1)
+    _, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    return faces[cnt[inv.ravel()] == 1]
+
+
+class Body:
+    """The SfePy problem on the rest mesh [m]: P2 displacement, per-region materials."""
+
+    def __init__(self, node_m, ele, lab, moduli, nu):
+        from sfepy.base.base import IndexedStruct, output
+        from sfepy.discrete import Equation, Equations, FieldVariable, Function, Integral, Material, Problem
+        from sfepy.discrete.conditions import Conditions, EssentialBC
+        from sfepy.discrete.fem import FEDomain, Field, Mesh
+        from sfepy.solvers.ls import ScipyDirect
+        from sfepy.solvers.nls import Newton
+        from sfepy.terms import Term
+        output.set_output(quiet=True)
+        mesh = Mesh.from_data('body', node_m, None, [ele.astype(np.int32)], [lab.astype(np.int32)], ['3_4'])
+        domain = FEDomain('domain', mesh)
+        omega = domain.create_region('Omega', 'all')
+        chest = domain.create_region('Chest', 'vertices in (z < 1e-9)', 'facet')
+        field = Field.from_args('displacement', np.float64, 'vector', omega, approx_order=2)
+        self.u = FieldVariable('u', 'unknown', field)
+        v = FieldVariable('v', 'test', field, primary_var_name='u')
+        integral = Integral('i', order=4)
+        self.g = np.zeros(3)
+
+        def force(ts, coors, mode=None, **kwargs):
+            if mode != 'qp':
+                return None
+            val = np.tile((RHO * self.g).reshape(1, 3, 1), (coors.shape[0], 1, 1))
+            return {'val': val}
+
+        f = Material('f', function=Function('force', force))
+        # Per-cell moduli as quadrature-point values (cell-major order, the region is every cell).
+        # (Terms on one region per material would be simpler; SfePy 2021.4 crashes on them.)
+        e_cell = np.array([moduli[int(k)] for k in lab], float)
+        mu_cell, k_cell = e_cell / (2 * (1 + nu)), e_cell / (3 * (1 - 2 * nu))
+
+        def material(ts, coors, mode=None, **kwargs):
+            if mode != 'qp':
+                return None
+            n_qp = coors.shape[0] // len(e_cell)
+            return {'mu': np.repeat(mu_cell, n_qp).reshape(-1, 1, 1), 'K': np.repeat(k_cell, n_qp).reshape(-1, 1, 1)}
+
+        m = Material('m', function=Function('material', material))
+        terms = (Term.new('dw_tl_he_neohook(m.mu, v, u)', integral, omega, m=m, v=v, u=self.u) +
+                 Term.new('dw_tl_bulk_penalty(m.K, v, u)', integral, omega, m=m, v=v, u=self.u) -
+                 Term.new('dw_volume_lvf(f.val, v)', integral, omega, f=f, v=v))
+        self.pb = Problem('body', equations=Equations([Equation('balance', terms)]))
+        self.pb.set_bcs(ebcs=Conditions([EssentialBC('chest', chest, {'u.all': 0.0})]))
+        self.status = IndexedStruct()
+        # No line search: the residual norm is not a merit function here (a full Newton step
+        # may raise it before the quadratic convergence sets in).
+        nls = Newton({'i_max': 25, 'eps_a': 1e-9, 'eps_r': 1e-9, 'ls_on': 1e10}, lin_solver=ScipyDirect({}),
+                     status=self.status)
+        self.pb.set_solver(nls)
+        self.n_vertices = len(node_m)
+
+    def solve(self, gravity):
+        """Equilibrium under `gravity` [m/s^2] by adaptive load steps; returns (solves, steps)."""
+        s, ds, prev, solves, steps = 0.0, 0.25, None, 0, 0
+        while s < 1 - 1e-12:
+            nxt = min(1.0, s + ds)
+            self.g = nxt * np.asarray(gravity, float)
+            st = self.pb.solve(state0=prev, save_results=False)
+            solves += 1
+            if self.status.condition == 0:
+                s, prev, steps = nxt, st.copy(deep=True), steps + 1
+                ds = min(1.0 - s if s < 1 else 1.0, ds * 1.5) or ds
+            else:
+                ds /= 2
+                if ds < 1.0 / 256:
+                    raise RuntimeError('the load ramp failed at %.1f %% of gravity' % (100 * nxt))
+        self.pb.solve(state0=prev, save_results=False)  # sets u to the converged state
+        return solves, steps
+
+    def displacement_at_vertices(self):
+        return self.u().reshape(-1, 3)[:self.n_vertices].copy()
+
+    def displacement_at(self, points_m):
+        return np.asarray(self.u.evaluate_at(points_m)).reshape(-1, 3)
+
+
+def write_scenes(d, fat_e):
+    common = ['units: mm', 'prone: {surface: prone.obj}', 'chest_wall: chest_wall.txt', 'landmarks: landmarks.csv',
+              'supine: {surface: supine.obj}', 'tumours:']
+    names = sorted(n[len('tumour_'):-len('_prone.obj')] for n in os.listdir(d) if n.endswith('_prone.obj'))
+    common += ['  - {name: %s, prone: tumour_%s_prone.obj, supine_ground_truth: tumour_%s_supine.obj}' % (n, n, n)
+               for n in names]
+    common += ['gravity: [0, 0, -9.81]', 'preset: balanced']
+    variants = {
+        'prone': ['material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}'],
+        'unloaded': ['material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}', 'prone_gravity: [0, 0, 9.81]'],
+        'estimated': ['material: {youngs_modulus: estimate, poisson_ratio: 0.49, density: 1000}',
+                      'prone_gravity: [0, 0, 9.81]'],
+    }
+    for name, extra in variants.items():
+        with open(os.path.join(d, 'scene_%s.yaml' % name), 'w') as f:
+            f.write('# Independent truth (SfePy, P2, heterogeneous, fat E = %g Pa): bench/make_independent_truth.py\n' % fat_e)
+            f.write('\n'.join(common + extra) + '\n')
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument('out')
+    ap.add_argument('--fat-youngs-moduli', type=float, nargs='+', default=[300, 1000, 3400])
+    ap.add_argument('--max-volume', type=float, default=1500, help='TetGen -a bound [mm^3]')
+    ap.add_argument('--poisson-ratio', type=float, default=0.49)
+    ap.add_argument('--gland-ratio', type=float, default=2.0)
+    ap.add_argument('--tumour-ratio', type=float, default=6.0)
+    o = ap.parse_args()
+    os.makedirs(o.out, exist_ok=True)
+    node, ele, landmarks, tumours, gland, dims = mesh_body(o.out, o.max_volume)
+    radius = 8.0
+    lab = labels(node, ele, tumours, gland, radius)
+    bface = boundary(ele)
+    used = np.unique(bface)
+    renum = -np.ones(len(node), dtype=int)
+    renum[used] = np.arange(len(used))
+    sface = renum[bface]
+    chest = np.nonzero(np.abs(node[used, 2]) < 1e-9)[0]
+    tum_surf = {n: icosphere(p, radius * 0.9) for n, p in tumours.items()}
+    node_m = node * 1e-3
+    print('%d vertices, %d tetrahedra (fat %d, gland %d, tumour %d), %d skin vertices' %
+          (len(node), len(ele), (lab == 1).sum(), (lab == 2).sum(), (lab == 3).sum(), len(used)))
+    for fat in o.fat_youngs_moduli:
+        t0 = time.time()
+        moduli = {1: fat, 2: o.gland_ratio * fat, 3: o.tumour_ratio * fat}
+        body = Body(node_m, ele, lab, moduli, o.poisson_ratio)
+        d = os.path.join(o.out, 'E%g' % fat)
+        os.makedirs(d, exist_ok=True)
+        info = {'generator': 'SfePy (P2 tetrahedra, TL neo-Hookean + bulk penalty), TetGen mesh',
+                'fat_youngs_modulus_Pa': fat, 'gland_youngs_modulus_Pa': moduli[2], 'tumour_youngs_modulus_Pa': moduli[3],
+                'poisson_ratio': o.poisson_ratio, 'vertices': int(len(node)), 'tetrahedra': int(len(ele))}
+        pos = {}
+        for which, g in (('prone', (0, 0, G)), ('supine', (0, 0, -G))):
+            solves, steps = body.solve(g)
+            du = body.displacement_at_vertices() * 1e3
+            pos[which] = node + du
+            info[which] = {'load_steps': steps, 'solves': solves, 'max_displacement_mm': float(np.abs(du).max())}
+            for n, (TV, TF) in tum_surf.items():
+                write_obj(os.path.join(d, 'tumour_%s_%s.obj' % (n, which)),
+                          TV + body.displacement_at(TV * 1e-3) * 1e3, TF)
+        write_obj(os.path.join(d, 'prone.obj'), pos['prone'][used], sface)
+        write_obj(os.path.join(d, 'supine.obj'), pos['supine'][used], sface)
+        np.savetxt(os.path.join(d, 'chest_wall.txt'), chest, fmt='%d')
+        with open(os.path.join(d, 'landmarks.csv'), 'w') as f:
+            for name, v in landmarks.items():
+                f.write('%d,%.6f,%.6f,%.6f\n' % ((renum[v],) + tuple(pos['supine'][v])))
+        write_scenes(d, fat)
+        info['seconds'] = time.time() - t0
+        json.dump(info, open(os.path.join(d, 'truth.json'), 'w'), indent=1)
+        print('fat E %g Pa: prone sag %.1f mm (%d load steps), supine %.1f mm (%d), %.0f s' %
+              (fat, info['prone']['max_displacement_mm'], info['prone']['load_steps'],
+               info['supine']['max_displacement_mm'], info['supine']['load_steps'], info['seconds']))
+        sys.stdout.flush()
+
+
+if __name__ == '__main__':
+    main()
