@@ -10,7 +10,9 @@ OUT=${1:?usage: run_independent_truth.sh OUT [fat E ...]}
 shift || true
 MODULI=${*:-300 1000 3400}
 here=$(cd "$(dirname "$0")" && pwd)
+set +u  # ROS's setup scripts read unset variables
 source "$here/../build/ws/devel/setup.bash"
+set -u
 for E in $MODULI; do
   [ -f "$OUT/E$E/truth.json" ] || PYTHONUNBUFFERED=1 /usr/bin/python3 "$here/make_independent_truth.py" "$OUT" \
     --fat-youngs-moduli "$E" --max-volume "${MAX_VOLUME:-5000}"
