@@ -11,6 +11,7 @@
 #include "breast_tumour_registration/core/rigid_transform.h"
 #include "breast_tumour_registration/core/tet_kinematics.h"
 #include "breast_tumour_registration/core/units.h"
+#include "breast_tumour_registration/core/unload_step.h"
 
 namespace btr {
 namespace {
@@ -52,14 +53,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   auto evaluate = [&](double E) {
     Candidate c;
     const double k = E / E0;  // the material scaled by k == the gravities divided by k
-    UnloadProblem pb;
-    pb.loaded = &prone;
-    pb.fixed = model.chest_wall;
-    pb.materials = model.materials;
-    pb.material_of = model.material_of;
-    pb.volume_form = model.volume_form;
-    pb.density = model.material.density;
-    pb.gravity = prone_gravity / k;
+    UnloadProblem pb = unload_problem(model, prone, prone_gravity / k);
     const double u = std::log(E);
     Points guess;
     if (known.size() >= 2) {

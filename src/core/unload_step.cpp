@@ -18,6 +18,18 @@ void set_rest_shape(RegistrationModel& model, const Points& rest, const StepRepo
   model.unload = report;
 }
 
+UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity) {
+  UnloadProblem pb;
+  pb.loaded = &loaded;
+  pb.fixed = model.chest_wall;
+  pb.materials = model.materials;
+  pb.material_of = model.material_of;
+  pb.volume_form = model.volume_form;
+  pb.density = model.material.density;
+  pb.gravity = gravity;
+  return pb;
+}
+
 StepReport unload_report(const UnloadResult& u, const Points& prone) {
   StepReport rep;
   rep.name = "unload";
@@ -37,15 +49,7 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
   if (!prone_gravity.allFinite() || !(prone_gravity.norm() > 0))
     throw InputError("prone_gravity: must be a finite, non-zero vector [m/s^2]");
   const TetMesh loaded{model.prone, model.rest.T};
-  UnloadProblem pb;
-  pb.loaded = &loaded;
-  pb.fixed = model.chest_wall;
-  pb.materials = model.materials;
-  pb.material_of = model.material_of;
-  pb.volume_form = model.volume_form;
-  pb.density = model.material.density;
-  pb.gravity = prone_gravity;
-  const UnloadResult u = estimate_unloaded_shape(pb, options);
+  const UnloadResult u = estimate_unloaded_shape(unload_problem(model, loaded, prone_gravity), options);
 
   StepReport rep = unload_report(u, model.prone);
   // The prone shape as rest misses the prone shape by about the sag; the estimate is kept when

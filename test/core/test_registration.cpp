@@ -76,6 +76,18 @@ std::string scene_with(const std::string& extra, const std::string& name, const 
   return path;
 }
 
+// A coarse phantom scene whose truth our FEM made at 600 Pa (a soft breast), in its own folder.
+std::string soft_phantom_dir(const std::string& name) {
+  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / name).string();
+  std::filesystem::remove_all(d);
+  PhantomSceneOptions o;
+  o.phantom.tet.cell_size = 0.012;
+  o.phantom.surface_rings = 12;
+  o.youngs_modulus = 600;
+  write_phantom_scene(d, o);
+  return d;
+}
+
 RegistrationResult register_scene(const std::string& path, const std::string& preset = "balanced") {
   const Scene s = load_scene(path);
   std::vector<std::string> warnings;
@@ -253,13 +265,7 @@ TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
 // breast, asked to estimate it: the estimate lands near the truth, the tumours within half a
 // millimetre; a range that excludes the truth is reported as a bound, not as converged.
 TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
-  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12_soft_e").string();
-  std::filesystem::remove_all(d);
-  PhantomSceneOptions o;
-  o.phantom.tet.cell_size = 0.012;
-  o.phantom.surface_rings = 12;
-  o.youngs_modulus = 600;
-  write_phantom_scene(d, o);
+  const std::string d = soft_phantom_dir("phantom12_soft_e");
   const std::string estimate = "material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]";
   const RegistrationResult r = register_scene(scene_with(estimate, "estimate", d));
   ASSERT_GE(r.reports.size(), 2u);
@@ -302,13 +308,7 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
 // hides most of the prone-as-rest error behind the surface; with landmarks alone it shows, and
 // unloading removes it.
 TEST(Unload, InThePipelineItBeatsTheProneShapeAsRestOnASoftBreast) {
-  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12_soft").string();
-  std::filesystem::remove_all(d);
-  PhantomSceneOptions o;
-  o.phantom.tet.cell_size = 0.012;
-  o.phantom.surface_rings = 12;
-  o.youngs_modulus = 600;
-  write_phantom_scene(d, o);
+  const std::string d = soft_phantom_dir("phantom12_soft");
   const std::string material = "material: {youngs_modulus: 600, poisson_ratio: 0.49, density: 1000}\n";
   for (const std::string steps : {"auto", "[rigid, landmarks]"}) {
     const std::string name = steps == "auto" ? "full" : "landmarks";

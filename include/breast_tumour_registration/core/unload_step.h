@@ -19,6 +19,10 @@ namespace btr {
 /// and its note says which shape was kept.
 StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options = {});
 
+/// The unload problem of `model`'s mesh, chest wall and materials for the imaged shape `loaded`
+/// (its vertices: model.prone, kept alive by the caller) under `gravity` [m/s^2].
+UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity);
+
 /// The step report of an unload (name "unload"; mismatch, cost, and how far the rest shape
 /// moved from `prone`).
 StepReport unload_report(const UnloadResult& unload, const Points& prone);
