@@ -19,6 +19,9 @@ field), and three scenes:
   scene_prone.yaml      the thesis's method: the prone shape as rest shape, E = 3400 Pa assumed
   scene_unloaded.yaml   prone_gravity given: unloaded at the assumed 3400 Pa
   scene_estimated.yaml  prone_gravity and youngs_modulus: estimate
+and, with the tissue layout given as regions (the prone gland surface gland_prone.obj, 2x, and
+the prone tumour surfaces, 6x: the ratios, not the moduli), the method told the heterogeneity:
+  scene_unloaded_regions.yaml, scene_estimated_regions.yaml
 and truth.json (moduli, sags, load steps, seconds).
 
 Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
@@ -156,7 +159,7 @@ class Body:
         return np.asarray(self.u.evaluate_at(points_m)).reshape(-1, 3)
 
 
-def write_scenes(d, fat_e):
+def write_scenes(d, fat_e, gland_ratio, tumour_ratio):
     common = ['units: mm', 'prone: {surface: prone.obj}', 'chest_wall: chest_wall.txt', 'landmarks: landmarks.csv',
               'supine: {surface: supine.obj}', 'tumours:']
     names = sorted(n[len('tumour_'):-len('_prone.obj')] for n in os.listdir(d) if n.endswith('_prone.obj'))
@@ -169,6 +172,11 @@ def write_scenes(d, fat_e):
         'estimated': ['material: {youngs_modulus: estimate, poisson_ratio: 0.49, density: 1000}',
                       'prone_gravity: [0, 0, 9.81]'],
     }
+    regions = ['regions:', '  - {name: gland, surface: gland_prone.obj, relative_stiffness: %g}' % gland_ratio]
+    regions += ['  - {name: tumour_%s, surface: tumour_%s_prone.obj, relative_stiffness: %g}' % (n, n, tumour_ratio)
+                for n in names]
+    variants['unloaded_regions'] = variants['unloaded'] + regions
+    variants['estimated_regions'] = variants['estimated'] + regions
     for name, extra in variants.items():
         with open(os.path.join(d, 'scene_%s.yaml' % name), 'w') as f:
             f.write('# Independent truth (SfePy, P2, heterogeneous, fat E = %g Pa): bench/make_independent_truth.py\n' % fat_e)
@@ -195,6 +203,9 @@ def main():
     sface = renum[bface]
     chest = np.nonzero(np.abs(node[used, 2]) < 1e-9)[0]
     tum_surf = {n: icosphere(p, radius * 0.9) for n, p in tumours.items()}
+    gland_surf = icosphere((0.0, 0.0, 0.0), 1.0)
+    gland_surf = (np.asarray(gland_surf[0]) * gland['axes'] + gland['centre'], gland_surf[1])
+    gland_surf[0][:, 2] = np.maximum(gland_surf[0][:, 2], 0.5)  # the ellipsoid's part behind the chest wall is cut off
     node_m = node * 1e-3
     print('%d vertices, %d tetrahedra (fat %d, gland %d, tumour %d), %d skin vertices' %
           (len(node), len(ele), (lab == 1).sum(), (lab == 2).sum(), (lab == 3).sum(), len(used)))
@@ -216,13 +227,16 @@ def main():
             for n, (TV, TF) in tum_surf.items():
                 write_obj(os.path.join(d, 'tumour_%s_%s.obj' % (n, which)),
                           TV + body.displacement_at(TV * 1e-3) * 1e3, TF)
+            if which == 'prone':
+                GV, GF = gland_surf
+                write_obj(os.path.join(d, 'gland_prone.obj'), GV + body.displacement_at(GV * 1e-3) * 1e3, GF)
         write_obj(os.path.join(d, 'prone.obj'), pos['prone'][used], sface)
         write_obj(os.path.join(d, 'supine.obj'), pos['supine'][used], sface)
         np.savetxt(os.path.join(d, 'chest_wall.txt'), chest, fmt='%d')
         with open(os.path.join(d, 'landmarks.csv'), 'w') as f:
             for name, v in landmarks.items():
                 f.write('%d,%.6f,%.6f,%.6f\n' % ((renum[v],) + tuple(pos['supine'][v])))
-        write_scenes(d, fat)
+        write_scenes(d, fat, o.gland_ratio, o.tumour_ratio)
         info['seconds'] = time.time() - t0
         json.dump(info, open(os.path.join(d, 'truth.json'), 'w'), indent=1)
         print('fat E %g Pa: prone sag %.1f mm (%d load steps), supine %.1f mm (%d), %.0f s' %

@@ -18,16 +18,9 @@ GravityResult solve_gravity(const GravityProblem& pb, const NewtonOptions& optio
   }
   TotalEnergy energy;
   std::vector<StableNeoHookean> materials{StableNeoHookean(pb.youngs_modulus, pb.poisson_ratio)};
-  std::vector<int> material_of;
-  if (!pb.inclusion.empty()) {
-    materials.push_back(StableNeoHookean(pb.inclusion_youngs_modulus, pb.poisson_ratio));
-    material_of.assign(rest.T.rows(), 0);
-    for (int t : pb.inclusion) {
-      if (t < 0 || t >= rest.T.rows()) throw InputError("solve_gravity: inclusion tetrahedron out of range");
-      material_of[t] = 1;
-    }
-  }
-  add_elastic_energy(energy, rest, materials, material_of, resolve_volume_form(pb.volume_form, pb.poisson_ratio));
+  for (double E : pb.region_youngs_modulus) materials.push_back(StableNeoHookean(E, pb.poisson_ratio));
+  // ElasticEnergy checks material_of's size and range.
+  add_elastic_energy(energy, rest, materials, pb.material_of, resolve_volume_form(pb.volume_form, pb.poisson_ratio));
   auto gravity = std::make_shared<GravityEnergy>(rest, pb.density, pb.gravity);
   energy.add(gravity);
   auto assembler =

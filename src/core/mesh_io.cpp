@@ -463,7 +463,75 @@ void write_ply(const std::string& path, const SurfaceMesh& m, double inv) {
 }
 
 // ---------------------------------------------------------------- VTK (legacy)
-TetMesh read_vtk(const std::string& path, double scale) {
+// Reads one dataset attribute section (POINT_DATA or CELL_DATA with `count` items): the
+// one-component SCALARS and FIELD arrays are kept in `arrays` (when given), the rest skipped.
+void read_vtk_attributes(TokenStream& ts, const std::string& path, long count, std::map<std::string, std::vector<double>>* arrays) {
+  auto values = [&](long n, std::vector<double>* out) {
+    if (static_cast<unsigned long>(n) > ts.remaining())
+      fail(path, ts.done() ? 0 : ts.peek().line, "attribute needs " + std::to_string(n) + " values, the file holds " + std::to_string(ts.remaining()));
+    for (long i = 0; i < n; ++i) {
+      const double v = ts.next_double("attribute value");
+      if (out) out->push_back(v);
+    }
+  };
+  while (!ts.done()) {
+    const std::string kw = lower(ts.peek().text);
+    if (kw == "point_data" || kw == "cell_data") return;
+    const auto tok = ts.next("attribute");
+    if (kw == "scalars") {
+      const std::string name = ts.next("scalars name").text;
+      ts.next("scalars type");
+      long comps = 1;
+      if (!ts.done() && ts.peek().line == tok.line) comps = ts.next_long("scalars components");
+      if (comps < 1 || comps > 4) fail(path, tok.line, "SCALARS '" + name + "' has " + std::to_string(comps) + " components (1 to 4)");
+      if (!ts.done() && lower(ts.peek().text) == "lookup_table") {
+        ts.next("lookup_table");
+        ts.next("lookup table name");
+      }
+      std::vector<double> v;
+      values(count * comps, comps == 1 && arrays ? &v : nullptr);
+      if (comps == 1 && arrays) (*arrays)[name] = std::move(v);
+    } else if (kw == "field") {
+      ts.next("field name");
+      const long k = ts.next_long("field array count");
+      for (long a = 0; a < k; ++a) {
+        const auto name = ts.next("field array name");
+        const long comps = ts.next_long("field array components");
+        const long tuples = ts.next_long("field array tuples");
+        ts.next("field array type");
+        if (comps < 1 || tuples != count)
+          fail(path, name.line, "FIELD array '" + name.text + "' has " + std::to_string(tuples) + " tuples of " +
+                                    std::to_string(comps) + " for " + std::to_string(count) + " items");
+        std::vector<double> v;
+        values(comps * tuples, comps == 1 && arrays ? &v : nullptr);
+        if (comps == 1 && arrays) (*arrays)[name.text] = std::move(v);
+      }
+    } else if (kw == "lookup_table") {
+      ts.next("lookup table name");
+      values(4 * ts.next_long("lookup table size"), nullptr);
+    } else if (kw == "vectors" || kw == "normals") {
+      ts.next("name");
+      ts.next("type");
+      values(3 * count, nullptr);
+    } else if (kw == "tensors") {
+      ts.next("name");
+      ts.next("type");
+      values(9 * count, nullptr);
+    } else if (kw == "color_scalars") {
+      ts.next("name");
+      values(count * ts.next_long("color components"), nullptr);
+    } else if (kw == "texture_coordinates") {
+      ts.next("name");
+      const long dim = ts.next_long("texture dimension");
+      ts.next("type");
+      values(dim * count, nullptr);
+    } else {
+      fail(path, tok.line, "unknown legacy VTK attribute '" + tok.text + "'");
+    }
+  }
+}
+
+TetMeshFile read_vtk(const std::string& path, double scale) {
   // Line 1 is the "# vtk DataFile" header, line 2 a free-form title.
   TokenStream ts(path, false, 2, "# vtk");
   ts.next("header");
@@ -471,6 +539,7 @@ TetMesh read_vtk(const std::string& path, double scale) {
   std::vector<Vec3> verts;
   std::vector<std::vector<int>> cells;
   std::vector<int> types;
+  std::map<std::string, std::vector<double>> cell_arrays;
   bool have_points = false, have_cells = false;
   while (!ts.done()) {
     const auto tok = ts.next("keyword");
@@ -501,15 +570,21 @@ TetMesh read_vtk(const std::string& path, double scale) {
       const long n = ts.next_count("cell type count", 1);
       for (long i = 0; i < n; ++i) types.push_back(static_cast<int>(ts.next_long("cell type")));
     } else if (kw == "point_data" || kw == "cell_data") {
-      break;  // attributes are not needed
+      const long n = ts.next_count(kw == "cell_data" ? "CELL_DATA count" : "POINT_DATA count", 0);
+      const long expected = kw == "cell_data" ? static_cast<long>(cells.size()) : static_cast<long>(verts.size());
+      if (n != expected)
+        fail(path, tok.line, tok.text + " " + std::to_string(n) + " does not match the " + std::to_string(expected) +
+                                 (kw == "cell_data" ? " cells" : " points"));
+      read_vtk_attributes(ts, path, n, kw == "cell_data" ? &cell_arrays : nullptr);
     }
   }
   if (!have_points || !have_cells) throw InputError(path + ": missing POINTS or CELLS section");
   if (!types.empty() && types.size() != cells.size())
     throw InputError(path + ": CELL_TYPES count differs from CELLS count");
-  TetMesh m;
-  m.V = to_points(verts, scale);
+  TetMeshFile f;
+  f.mesh.V = to_points(verts, scale);
   std::vector<Eigen::Vector4i> tets;
+  std::vector<size_t> tet_cell;  // VTK cell of each tetrahedron (for the cell data)
   for (size_t i = 0; i < cells.size(); ++i) {
     const int type = types.empty() ? (cells[i].size() == 4 ? 10 : -1) : types[i];
     if (type == 1 || type == 3 || type == 5) continue;  // vertices, lines, triangles (e.g. boundary) are skipped
@@ -517,15 +592,21 @@ TetMesh read_vtk(const std::string& path, double scale) {
       throw InputError(path + ": cell " + std::to_string(i) + " has VTK type " + std::to_string(type) +
                        " (only tetrahedra, type 10, are supported)");
     tets.emplace_back(cells[i][0], cells[i][1], cells[i][2], cells[i][3]);
+    tet_cell.push_back(i);
   }
-  m.T.resize(tets.size(), 4);
-  for (size_t i = 0; i < tets.size(); ++i) m.T.row(i) = tets[i].transpose();
-  if (m.T.rows() == 0) throw InputError(path + ": no tetrahedra");
-  check_indices(path, m.T, m.V.rows(), "tetrahedron");
-  return m;
+  f.mesh.T.resize(tets.size(), 4);
+  for (size_t i = 0; i < tets.size(); ++i) f.mesh.T.row(i) = tets[i].transpose();
+  if (f.mesh.T.rows() == 0) throw InputError(path + ": no tetrahedra");
+  check_indices(path, f.mesh.T, f.mesh.V.rows(), "tetrahedron");
+  for (auto& [name, v] : cell_arrays) {
+    std::vector<double> per_tet(tet_cell.size());
+    for (size_t i = 0; i < tet_cell.size(); ++i) per_tet[i] = v[tet_cell[i]];
+    f.cell_arrays[name] = std::move(per_tet);
+  }
+  return f;
 }
 
-void write_vtk(const std::string& path, const TetMesh& m, double inv) {
+void write_vtk(const std::string& path, const TetMesh& m, double inv, const std::vector<int>& labels) {
   auto out = open_out(path);
   out << "# vtk DataFile Version 3.0\nbreast_tumour_registration tetrahedral mesh\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   out << "POINTS " << m.V.rows() << " double\n";
@@ -536,10 +617,13 @@ void write_vtk(const std::string& path, const TetMesh& m, double inv) {
     out << "4 " << m.T(i, 0) << ' ' << m.T(i, 1) << ' ' << m.T(i, 2) << ' ' << m.T(i, 3) << '\n';
   out << "CELL_TYPES " << m.T.rows() << '\n';
   for (Eigen::Index i = 0; i < m.T.rows(); ++i) out << "10\n";
+  if (labels.empty()) return;
+  out << "CELL_DATA " << m.T.rows() << "\nSCALARS label int 1\nLOOKUP_TABLE default\n";
+  for (int l : labels) out << l << '\n';
 }
 
 // ---------------------------------------------------------------- Medit
-TetMesh read_medit(const std::string& path, double scale) {
+TetMeshFile read_medit(const std::string& path, double scale) {
   TokenStream ts(path, true);
   auto skip_block = [&](int per_item) {
     const long n = ts.next_long("count");
@@ -547,6 +631,7 @@ TetMesh read_medit(const std::string& path, double scale) {
   };
   std::vector<Vec3> verts;
   std::vector<Eigen::Vector4i> tets;
+  std::vector<double> refs;
   bool have_v = false;
   while (!ts.done()) {
     const auto tok = ts.next("keyword");
@@ -567,7 +652,7 @@ TetMesh read_medit(const std::string& path, double scale) {
       for (long i = 0; i < n; ++i) {
         Eigen::Vector4i t;
         for (int c = 0; c < 4; ++c) t[c] = static_cast<int>(ts.next_long("tetrahedron index")) - 1;  // 1-based
-        ts.next("tetrahedron reference");
+        refs.push_back(static_cast<double>(ts.next_long("tetrahedron reference")));
         tets.push_back(t);
       }
     } else if (kw == "triangles") {
@@ -583,22 +668,24 @@ TetMesh read_medit(const std::string& path, double scale) {
     }
   }
   if (!have_v || tets.empty()) throw InputError(path + ": missing Vertices or Tetrahedra section");
-  TetMesh m;
-  m.V = to_points(verts, scale);
-  m.T.resize(tets.size(), 4);
-  for (size_t i = 0; i < tets.size(); ++i) m.T.row(i) = tets[i].transpose();
-  check_indices(path, m.T, m.V.rows(), "tetrahedron");
-  return m;
+  TetMeshFile f;
+  f.mesh.V = to_points(verts, scale);
+  f.mesh.T.resize(tets.size(), 4);
+  for (size_t i = 0; i < tets.size(); ++i) f.mesh.T.row(i) = tets[i].transpose();
+  check_indices(path, f.mesh.T, f.mesh.V.rows(), "tetrahedron");
+  f.cell_arrays["ref"] = std::move(refs);
+  return f;
 }
 
-void write_medit(const std::string& path, const TetMesh& m, double inv) {
+void write_medit(const std::string& path, const TetMesh& m, double inv, const std::vector<int>& labels) {
   auto out = open_out(path);
   out << "MeshVersionFormatted 2\nDimension 3\nVertices\n" << m.V.rows() << '\n';
   for (Eigen::Index i = 0; i < m.V.rows(); ++i)
     out << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << " 0\n";
   out << "Tetrahedra\n" << m.T.rows() << '\n';
   for (Eigen::Index i = 0; i < m.T.rows(); ++i)
-    out << m.T(i, 0) + 1 << ' ' << m.T(i, 1) + 1 << ' ' << m.T(i, 2) + 1 << ' ' << m.T(i, 3) + 1 << " 1\n";
+    out << m.T(i, 0) + 1 << ' ' << m.T(i, 1) + 1 << ' ' << m.T(i, 2) + 1 << ' ' << m.T(i, 3) + 1 << ' '
+        << (labels.empty() ? 1 : labels[i]) << '\n';
   out << "End\n";
 }
 
@@ -655,7 +742,7 @@ Points read_point_cloud(const std::string& path, LengthUnit unit) {
   return P;
 }
 
-TetMesh read_tet_mesh(const std::string& path, LengthUnit unit) {
+TetMeshFile read_tet_mesh_file(const std::string& path, LengthUnit unit) {
   const std::string ext = file_extension(path);
   const double s = metres_per_unit(unit);
   if (ext == ".vtk") return read_vtk(path, s);
@@ -663,11 +750,41 @@ TetMesh read_tet_mesh(const std::string& path, LengthUnit unit) {
   throw InputError("'" + path + "': unknown tetrahedral mesh format '" + ext + "' (expected .vtk or .mesh)");
 }
 
-void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit) {
+TetMesh read_tet_mesh(const std::string& path, LengthUnit unit) { return read_tet_mesh_file(path, unit).mesh; }
+
+std::vector<int> cell_labels(const TetMeshFile& file, const std::string& array, const std::string& path) {
+  std::string names;
+  for (const auto& [n, v] : file.cell_arrays) names += (names.empty() ? "'" : ", '") + n + "'";
+  if (names.empty()) names = "none";
+  const std::vector<double>* values = nullptr;
+  if (!array.empty()) {
+    const auto it = file.cell_arrays.find(array);
+    if (it == file.cell_arrays.end())
+      throw InputError(path + ": no one-component cell array '" + array + "' (the file has: " + names + ")");
+    values = &it->second;
+  } else if (file.cell_arrays.size() == 1) {
+    values = &file.cell_arrays.begin()->second;
+  } else {
+    throw InputError(path + ": " + (file.cell_arrays.empty() ? std::string("no cell labels (no one-component CELL_DATA array)")
+                                                             : "several cell arrays (" + names + "): name the labels with prone.cell_labels"));
+  }
+  std::vector<int> labels(values->size());
+  for (size_t t = 0; t < values->size(); ++t) {
+    const double v = (*values)[t];
+    if (!(std::abs(v) < 1e9) || v != std::round(v))
+      throw InputError(path + ": cell label of tetrahedron " + std::to_string(t) + " is " + std::to_string(v) + ", not an integer");
+    labels[t] = static_cast<int>(v);
+  }
+  return labels;
+}
+
+void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit, const std::vector<int>& labels) {
+  if (!labels.empty() && static_cast<Eigen::Index>(labels.size()) != mesh.T.rows())
+    throw InputError("'" + path + "': " + std::to_string(labels.size()) + " cell labels for " + std::to_string(mesh.T.rows()) + " tetrahedra");
   const std::string ext = file_extension(path);
   const double inv = 1.0 / metres_per_unit(unit);
-  if (ext == ".vtk") return write_vtk(path, mesh, inv);
-  if (ext == ".mesh") return write_medit(path, mesh, inv);
+  if (ext == ".vtk") return write_vtk(path, mesh, inv, labels);
+  if (ext == ".mesh") return write_medit(path, mesh, inv, labels);
   throw InputError("'" + path + "': unknown tetrahedral mesh format '" + ext + "' (expected .vtk or .mesh)");
 }
 

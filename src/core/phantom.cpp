@@ -95,6 +95,13 @@ PhantomModel make_phantom_model(const PhantomOptions& opt) {
     if (centre.z() - r < 0.0) throw InputError("phantom: tumour '" + name + "' would cross the chest wall");
     m.tumours[name] = make_icosphere(centre, r, opt.tumour_subdivisions);
   }
+  if (!(opt.gland_axes.minCoeff() > 0) || !(opt.gland_centre_z - opt.gland_axes.z() > 0) ||
+      !(opt.gland_centre_z + opt.gland_axes.z() < 1) || !(opt.gland_axes.x() < 1 && opt.gland_axes.y() < 1))
+    throw InputError("phantom: the gland ellipsoid must lie inside the breast (0 < centre_z - axis_z, centre_z + axis_z < 1)");
+  m.gland = make_icosphere(Vec3::Zero(), 1.0, opt.tumour_subdivisions);
+  for (Eigen::Index i = 0; i < m.gland.V.rows(); ++i)
+    m.gland.V.row(i) = Vec3(a * opt.gland_axes.x() * m.gland.V(i, 0), b * opt.gland_axes.y() * m.gland.V(i, 1),
+                            c * (opt.gland_centre_z + opt.gland_axes.z() * m.gland.V(i, 2))).transpose();
   m.chest_ring = make_chest_ring(a, b, opt.ring_width, 6 * opt.surface_rings);
   return m;
 }

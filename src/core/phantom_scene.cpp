@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -16,14 +17,41 @@
 
 namespace btr {
 
-PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomSceneOptions& opt,
-                                       const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
-  StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio);  // validates before the expensive steps
-  std::vector<int> inclusion;
+std::vector<int> phantom_tissue_labels(const PhantomModel& model, const PhantomSceneOptions& opt) {
+  if (opt.gland_youngs_modulus < 0 || opt.tumour_youngs_modulus < 0 || !std::isfinite(opt.gland_youngs_modulus) ||
+      !std::isfinite(opt.tumour_youngs_modulus))
+    throw InputError("phantom: gland and tumour Young's moduli must be >= 0 (0: the body's material)");
+  if (opt.gland_youngs_modulus == 0 && opt.tumour_youngs_modulus == 0) return {};
+  std::vector<int> labels(model.rest.T.rows(), kPhantomFatLabel);
+  if (opt.gland_youngs_modulus > 0) {
+    if (model.gland.F.rows() == 0) throw InputError("phantom: the rest model has no gland region to stiffen");
+    for (int t : tetrahedra_inside(model.rest, {&model.gland})) labels[t] = kPhantomGlandLabel;
+  }
   if (opt.tumour_youngs_modulus > 0) {
     std::vector<const SurfaceMesh*> tumours;
     for (const auto& [name, t] : model.tumours) tumours.push_back(&t);
-    inclusion = tetrahedra_inside(model.rest, tumours);
+    for (int t : tetrahedra_inside(model.rest, tumours)) labels[t] = kPhantomTumourLabel;
+  }
+  return labels;
+}
+
+PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomSceneOptions& opt,
+                                       const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
+  StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio);  // validates before the expensive steps
+  const std::vector<int> labels = phantom_tissue_labels(model, opt);
+  std::vector<int> material_of;  // label 1, 2, 3 -> body, gland, tumour material
+  std::vector<double> region_E;
+  if (!labels.empty()) {
+    std::vector<int> index_of(4, 0);
+    if (opt.gland_youngs_modulus > 0) {
+      region_E.push_back(opt.gland_youngs_modulus);
+      index_of[kPhantomGlandLabel] = static_cast<int>(region_E.size());
+    }
+    if (opt.tumour_youngs_modulus > 0) {
+      region_E.push_back(opt.tumour_youngs_modulus);
+      index_of[kPhantomTumourLabel] = static_cast<int>(region_E.size());
+    }
+    for (int l : labels) material_of.push_back(index_of[l]);
   }
   auto solve = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
     GravityProblem pb;
@@ -34,8 +62,8 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     pb.volume_form = opt.volume_form;
     pb.density = opt.density;
     pb.gravity = g;
-    pb.inclusion = inclusion;
-    pb.inclusion_youngs_modulus = opt.tumour_youngs_modulus;
+    pb.material_of = material_of;
+    pb.region_youngs_modulus = region_E;
     NewtonOptions newton;
     if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
     GravityResult r = solve_gravity(pb, newton);
@@ -44,6 +72,7 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     return r.x;
   };
   PhantomConfigurations c;
+  c.labels = labels;
   c.prone = solve("prone", model.prone_gravity, c.prone_newton);
   c.supine = solve("supine", model.supine_gravity, c.supine_newton);
   for (const auto& [name, t] : model.tumours) {
@@ -77,7 +106,7 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   write_rest_model(dir, model, unit);  // rest.vtk, chest_wall.txt, chest_ring.obj, tumours, model.yaml
   TetMesh m = model.rest;
   m.V = prone;
-  write_tet_mesh(path("prone.vtk"), m, unit);
+  write_tet_mesh(path("prone.vtk"), m, unit, conf.labels);  // the tissue labels a segmentation would give
   write_surface(path("prone_surface.obj"), boundary_surface(m), unit);
   m.V = supine;
   write_tet_mesh(path("supine.vtk"), m, unit);
@@ -125,6 +154,27 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   scene["landmark_set"] = opt.landmark_set;
   scene["landmark_vertices"] = lm_vertices;
   scene["tumours"] = tumours;
+  // Heterogeneous truth: the method is told the tissue layout (the labels) and the stiffness
+  // ratios, not the absolute moduli (its body material stays the thesis's, or is estimated).
+  if (!conf.labels.empty()) {
+    if (opt.gland_youngs_modulus > 0) {
+      write_surface(path("gland_rest.obj"), model.gland, unit);
+      const Embedding emb = embed_points(model.rest, model.gland.V, OutsidePolicy::Error);
+      write_surface(path("gland_prone.obj"), SurfaceMesh{apply_embedding(emb, model.rest.T, prone), model.gland.F}, unit);
+    }
+    YAML::Node regions;
+    auto region = [&](const char* name, int label, double E) {
+      if (E <= 0) return;
+      YAML::Node r;
+      r["name"] = name;
+      r["label"] = label;
+      r["relative_stiffness"] = E / opt.youngs_modulus;
+      regions.push_back(r);
+    };
+    region("gland", kPhantomGlandLabel, opt.gland_youngs_modulus);
+    region("tumour", kPhantomTumourLabel, opt.tumour_youngs_modulus);
+    scene["regions"] = regions;
+  }
   scene["material"]["youngs_modulus"] = 3400.0;
   scene["material"]["poisson_ratio"] = 0.49;
   scene["material"]["density"] = 1000.0;
@@ -136,6 +186,7 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   scene["generator"]["volume_form"] = to_string(resolve_volume_form(opt.volume_form, opt.poisson_ratio));
   scene["generator"]["density"] = opt.density;
   scene["generator"]["tumour_youngs_modulus"] = opt.tumour_youngs_modulus;
+  scene["generator"]["gland_youngs_modulus"] = opt.gland_youngs_modulus;
   scene["generator"]["cell_size_mm"] = opt.phantom.tet.cell_size * 1e3;
   scene["generator"]["tetrahedra"] = sum.tetrahedra;
   YAML::Emitter y;

@@ -32,6 +32,8 @@ RegistrationModel make_registration_model(const TetMesh& prone, const std::vecto
   if (!(material.density > 0) || !std::isfinite(material.density))
     throw InputError("material.density must be positive (kg/m^3)");
   m.material_of.assign(m.rest.T.rows(), 0);
+  m.material_names = {"body"};
+  m.material_tetrahedra = {static_cast<long>(m.rest.T.rows())};
   m.gravity = gravity;
   for (Eigen::Index t = 0; t < m.rest.T.rows(); ++t) m.volume += tet_signed_volume(m.rest.V, m.rest.T, t);
   m.prone = m.rest.V;
@@ -56,14 +58,21 @@ void add_model_elastic_energy(TotalEnergy& energy, const RegistrationModel& mode
 }
 
 void stiffen_tumours(RegistrationModel& model, double E) {
-  model.materials.erase(model.materials.begin() + 1, model.materials.end());
+  const int index = static_cast<int>(model.materials.size());
   model.materials.push_back(StableNeoHookean(E, model.material.poisson_ratio));
-  std::fill(model.material_of.begin(), model.material_of.end(), 0);
+  model.material_names.push_back("tumour");
+  model.material_tetrahedra.push_back(0);
   std::vector<const SurfaceMesh*> surfaces;
   for (const auto& t : model.tumours) surfaces.push_back(&t.prone);
   const std::vector<int> inside = tetrahedra_inside(TetMesh{model.prone, model.rest.T}, surfaces);
-  for (int e : inside) model.material_of[e] = 1;
+  for (int e : inside) model.material_of[e] = index;
   model.stiff_tetrahedra = static_cast<long>(inside.size());
+  count_material_tetrahedra(model);
+}
+
+void count_material_tetrahedra(RegistrationModel& model) {
+  model.material_tetrahedra.assign(model.materials.size(), 0);
+  for (int m : model.material_of) ++model.material_tetrahedra[m];
 }
 
 }  // namespace btr

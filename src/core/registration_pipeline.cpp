@@ -7,6 +7,7 @@
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/gravity_energy.h"
 #include "breast_tumour_registration/core/elastic_energy.h"
+#include "breast_tumour_registration/core/material_regions.h"
 #include "breast_tumour_registration/core/metrics.h"
 #include "breast_tumour_registration/core/rigid_regions.h"
 #include "breast_tumour_registration/core/simulation_mesh.h"
@@ -155,6 +156,7 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
                          std::to_string(m.tumours.back().embedding.max_outside_distance * 1e3) +
                          " mm); they follow the nearest tetrahedron");
   }
+  assign_material_regions(m, scene.regions, scene.prone_labels);
   if (scene.tumour_youngs_modulus) {
     stiffen_tumours(m, *scene.tumour_youngs_modulus);
     if (m.stiff_tetrahedra == 0)

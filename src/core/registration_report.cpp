@@ -44,6 +44,14 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
     << ",\n  \"mesh\": {\"vertices\": " << model.rest.V.rows() << ", \"tetrahedra\": " << model.rest.T.rows()
     << ", \"chest_wall_vertices\": " << model.chest_wall.size() << ", \"skin_vertices\": " << model.skin.size()
     << ", \"stiff_tumour_tetrahedra\": " << model.stiff_tetrahedra << "},\n";
+  j << "  \"materials\": [";
+  for (size_t i = 0; i < model.materials.size(); ++i) {
+    const double mu = model.materials[i].mu(), lambda_lame = model.materials[i].lambda() - mu;
+    j << (i ? ", " : "") << "{\"name\": " << quote(i < model.material_names.size() ? model.material_names[i] : "")
+      << ", \"youngs_modulus_Pa\": " << num(mu * (3 * lambda_lame + 2 * mu) / (lambda_lame + mu))
+      << ", \"tetrahedra\": " << (i < model.material_tetrahedra.size() ? model.material_tetrahedra[i] : 0) << "}";
+  }
+  j << "],\n";
   if (r.steps.stiffness) {
     j << "  \"stiffness\": {\"estimated_youngs_modulus_Pa\": " << num(r.estimated_youngs_modulus) << ", \"evaluations\": [";
     for (size_t i = 0; i < r.stiffness_evaluations.size(); ++i)

@@ -8,6 +8,7 @@
 
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/index_io.h"
+#include "breast_tumour_registration/core/material_regions.h"
 #include "breast_tumour_registration/core/mesh_io.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 #include "breast_tumour_registration/core/surface_orientation.h"
@@ -40,7 +41,8 @@ const std::vector<std::string> kSceneKeys = {
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
-    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "tumour_material",
+    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "regions", "regions[]",
+    "regions[].name", "regions[].youngs_modulus", "regions[].relative_stiffness", "regions[].label", "regions[].surface", "prone.cell_labels", "tumour_material",
     "tumour_material.youngs_modulus", "gravity", "prone_gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
     "misalignment.translation_mm", "generator.*"};
 
@@ -109,10 +111,12 @@ Scene load_scene_fields(const std::string& path) {
     check_length_scale(prone_surface.V, s.units, path, "prone.surface");
     have_surface = true;
   }
+  TetMeshFile prone_file;  // with its cell data, for the regions' labels
   if (prone["tet_mesh"]) {
+    prone_file = c.load("prone.tet_mesh", [&] { return read_tet_mesh_file(c.path_of(prone["tet_mesh"], "prone.tet_mesh"), s.units); });
     s.prone = c.load("prone.tet_mesh", [&] {
-      TetMesh m = read_tet_mesh(c.path_of(prone["tet_mesh"], "prone.tet_mesh"), s.units);
-      orient_tets_positive(m);
+      TetMesh m = prone_file.mesh;
+      orient_tets_positive(m);  // reorders each tetrahedron's corners, not the tetrahedra: the labels keep
       validate_tet_mesh(m, "prone.tet_mesh");
       return m;
     });
@@ -134,6 +138,7 @@ Scene load_scene_fields(const std::string& path) {
   } else {
     c.fail("prone", "give prone.tet_mesh or prone.surface");
   }
+  if (prone["cell_labels"] && !prone["tet_mesh"]) c.fail("prone.cell_labels", "only with prone.tet_mesh (the file holding them)");
   if (prone["cell_size_mm"] && !have_surface) c.fail("prone.cell_size_mm", "only with prone.surface (the size it is tetrahedralized at)");
 
   // Chest wall: tet vertex indices, or surface indices re-attached after tetrahedralization.
@@ -256,7 +261,7 @@ Scene load_scene_fields(const std::string& path) {
   if (const YAML::Node m = root["material"]) {
     if (m["youngs_modulus"]) {
       if (m["youngs_modulus"].IsScalar() && m["youngs_modulus"].Scalar() == "estimate") {
-        s.youngs_modulus_range = std::array<double, 2>{150, 24000};
+        s.youngs_modulus_range = std::array<double, 2>{150, 24000};  // the reference stays 3400 Pa
       } else {
         s.material.youngs_modulus = c.number(m["youngs_modulus"], "material.youngs_modulus");
       }
@@ -281,6 +286,47 @@ Scene load_scene_fields(const std::string& path) {
   }
   c.load("material", [&] { StableNeoHookean(s.material.youngs_modulus, s.material.poisson_ratio); return 0; });
   if (!(s.material.density > 0)) c.fail("material.density", "must be positive (kg/m^3)");
+  // Material regions (material_regions.h): after the material, whose Poisson's ratio they share.
+  if (const YAML::Node rs = root["regions"]) {
+    if (!rs.IsSequence()) c.fail("regions", "expected a list of {name, youngs_modulus, label or surface}");
+    bool by_label = false;
+    int i = 0;
+    for (const auto& r : rs) {
+      const std::string f = "regions[" + std::to_string(i++) + "]";
+      if (!r.IsMap()) c.fail(f, "expected a mapping {name, youngs_modulus, label or surface}");
+      MaterialRegion mr;
+      if (!r["name"]) c.fail(f + ".name", "missing: a region needs a name (e.g. gland)");
+      mr.name = c.text(r["name"], f + ".name");
+      if (r["youngs_modulus"].IsDefined() == r["relative_stiffness"].IsDefined())
+        c.fail(f, "give exactly one of 'youngs_modulus' [Pa] and 'relative_stiffness' (times material.youngs_modulus)");
+      if (r["youngs_modulus"]) {
+        mr.youngs_modulus = c.number(r["youngs_modulus"], f + ".youngs_modulus");
+      } else {
+        const double k = c.number(r["relative_stiffness"], f + ".relative_stiffness");
+        if (!(k > 0) || !std::isfinite(k)) c.fail(f + ".relative_stiffness", "must be a positive number");
+        mr.youngs_modulus = k * s.material.youngs_modulus;
+      }
+      if (r["label"]) {
+        const double l = c.number(r["label"], f + ".label");
+        if (l != std::round(l) || std::abs(l) > 1e9) c.fail(f + ".label", "expected an integer cell label");
+        mr.label = static_cast<int>(l);
+        by_label = true;
+      }
+      if (r["surface"])
+        mr.surface = c.load(f + ".surface", [&] {
+          SurfaceMesh m = read_surface(c.path_of(r["surface"], f + ".surface"), s.units);
+          repair_orientation(m, f + ".surface", s.warnings);
+          return m;
+        });
+      c.load(f, [&] { validate_material_region(mr, "region"); return 0; });
+      s.regions.push_back(std::move(mr));
+    }
+    if (by_label) {
+      if (!prone["tet_mesh"]) c.fail("regions", "a region by label needs prone.tet_mesh with cell labels");
+      const std::string array = prone["cell_labels"] ? c.text(prone["cell_labels"], "prone.cell_labels") : "";
+      s.prone_labels = c.load("prone.tet_mesh", [&] { return cell_labels(prone_file, array, c.path_of(prone["tet_mesh"], "prone.tet_mesh")); });
+    }
+  }
   if (const YAML::Node m = root["tumour_material"]) {
     s.tumour_youngs_modulus = c.number(m["youngs_modulus"], "tumour_material.youngs_modulus");
     c.load("tumour_material", [&] { StableNeoHookean(*s.tumour_youngs_modulus, s.material.poisson_ratio); return 0; });

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/core/material_regions.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 #include "breast_tumour_registration/core/tetrahedralize.h"
 
@@ -30,6 +31,7 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size) {
   for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
     landmarks.row(static_cast<Eigen::Index>(i)) = scene.landmark_anchors[i].position(scene.prone.V).transpose();
   if (landmarks.rows()) out.landmark_anchors = attach_to_boundary(out.prone, landmarks).anchors;
+  if (!scene.prone_labels.empty()) out.prone_labels = transfer_cell_labels(scene.prone, scene.prone_labels, out.prone);
   out.tetrahedralized = true;
   out.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;

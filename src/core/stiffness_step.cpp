@@ -187,6 +187,18 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   }
   est.youngs_modulus = std::exp(u_best);
   est.scale = est.youngs_modulus / E0;
+  // A candidate is accepted once its unloaded shape reproduces the prone shape within 0.1 mm;
+  // the chosen one is finished from there, so that the unload step's "converged" holds.
+  if (!c_best.unload.converged) {
+    UnloadProblem pb = unload_problem(model, prone, prone_gravity / est.scale);
+    pb.initial_rest = &c_best.rest;
+    UnloadResult polished = estimate_unloaded_shape(pb, opt.unload);
+    if (polished.converged || polished.max_mismatch < c_best.unload.max_mismatch) {
+      polished.seconds += c_best.unload.seconds;
+      c_best.unload = std::move(polished);
+      c_best.rest = c_best.unload.rest;
+    }
+  }
   est.misfit = c_best.misfit;
   est.rest = c_best.rest;
   est.unload = c_best.unload;

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   double E = 3400, nu = 0.49, rho = 1000, cell_mm = 8.0, tumour_mm = 10.0, ratio = 2.0;
   std::string units = "mm", landmark_set = "C+O";
   bool quiet = false;
-  double tumour_E = 0;
+  double tumour_E = 0, gland_E = 0;
   app.add_option("-o,--out", out_dir, "output folder (created)")->capture_default_str();
   app.add_option("-E,--youngs-modulus", E, "Young's modulus used to generate prone and supine [Pa]")->capture_default_str()
       ->check(btr::cli::positive());
@@ -40,6 +40,11 @@ int main(int argc, char** argv) {
   app.add_option("--landmarks", landmark_set, "landmark set: C+O, O+Oa+I, O+I, O+Oa, Oa+I, or names like C,O1,O2")
       ->capture_default_str();
   app.add_option("--tumour-youngs-modulus", tumour_E, "generate with stiff tumours of this Young's modulus [Pa] (0: homogeneous)")
+      ->capture_default_str()
+      ->check(btr::cli::non_negative());
+  app.add_option("--gland-youngs-modulus", gland_E, "generate with a fibroglandular region of this Young's modulus [Pa] "
+                                                    "(0: the body's); with either, prone.vtk carries tissue labels and the "
+                                                    "scene their regions")
       ->capture_default_str()
       ->check(btr::cli::non_negative());
   std::string volume_form = "auto";
@@ -62,6 +67,7 @@ int main(int argc, char** argv) {
     o.phantom.tet.radius_edge_ratio = ratio;
     o.phantom.tumour_radius = tumour_mm * 1e-3;
     o.tumour_youngs_modulus = tumour_E;
+    o.gland_youngs_modulus = gland_E;
     std::printf("[phantom] tetrahedralizing the half ellipsoid (cell size %.2f mm) and solving prone and supine...\n", cell_mm);
     const auto progress = [&](const std::string& name, const IterationInfo& it) {
       if (!quiet)

@@ -79,6 +79,12 @@ int main(int argc, char** argv) {
     std::printf("[register] %s: %ld vertices, %ld tetrahedra%s; steps: %s; preset %s\n", scene_path.c_str(),
                 static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows()),
                 scene.tetrahedralized ? " (tetrahedralized)" : "", plan.describe().c_str(), scene.preset.c_str());
+    if (model.materials.size() > 1) {
+      std::string mats;
+      for (size_t i = 0; i < model.materials.size(); ++i)
+        mats += (i ? ", " : "") + model.material_names[i] + " " + std::to_string(model.material_tetrahedra[i]) + " tetrahedra";
+      std::printf("[register] materials: %s\n", mats.c_str());
+    }
     for (const auto& w : warnings) std::printf("[register] warning: %s\n", w.c_str());
 
     StepCallback progress;

@@ -192,3 +192,54 @@ TEST(MeshIoErrors, HostileCountsAndIndicesAreRefusedBeforeAllocating) {
   btr::test::write_text(dir + "/header.csv", "prone_index,x,y,z\n5,1,2,3\n");
   EXPECT_EQ(read_landmark_pairs(dir + "/header.csv", LengthUnit::Metre).size(), 1u);
 }
+
+// Issue 13: tissue labels travel with the tetrahedral mesh (VTK cell data, Medit references).
+class TetLabelRoundTrip : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(TetLabelRoundTrip, LabelsSurvive) {
+  const TetMesh m = make_box_tet_mesh(2, 1, 1, Vec3(0.02, 0.01, 0.01));
+  std::vector<int> labels(m.T.rows());
+  for (Eigen::Index t = 0; t < m.T.rows(); ++t) labels[t] = 1 + static_cast<int>(t % 3);
+  const std::string path = temp_dir() + "/labelled" + GetParam();
+  write_tet_mesh(path, m, LengthUnit::Millimetre, labels);
+  const TetMeshFile f = read_tet_mesh_file(path, LengthUnit::Millimetre);
+  EXPECT_EQ(f.mesh.T, m.T);
+  EXPECT_EQ(cell_labels(f, "", path), labels);
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, TetLabelRoundTrip, ::testing::Values(".vtk", ".mesh"));
+
+TEST(MeshIo, VtkCellDataOfOtherToolsIsRead) {
+  // As meshio and TetGen write it: point data first, a FIELD block, SCALARS with a lookup
+  // table, and triangle cells (skipped, with their cell data) before the tetrahedra.
+  const std::string dir = temp_dir();
+  write_text(dir + "/two.vtk",
+             "# vtk DataFile Version 4.2\ntitle\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 5 double\n"
+             "0 0 0\n10 0 0\n0 10 0\n0 0 10\n10 10 10\nCELLS 3 13\n3 0 1 2\n4 0 1 2 3\n4 1 2 3 4\n"
+             "CELL_TYPES 3\n5\n10\n10\n"
+             "POINT_DATA 5\nVECTORS disp double\n0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n"
+             "CELL_DATA 3\nFIELD FieldData 2\ntissue 1 3 int\n9 1 2\nstrain 3 3 double\n0 0 0 0 0 0 0 0 0\n"
+             "SCALARS quality float 1\nLOOKUP_TABLE default\n0.5 0.7 0.8\n");
+  const TetMeshFile f = read_tet_mesh_file(dir + "/two.vtk", LengthUnit::Millimetre);
+  ASSERT_EQ(f.mesh.T.rows(), 2);
+  EXPECT_EQ(cell_labels(f, "tissue", dir + "/two.vtk"), (std::vector<int>{1, 2}));
+  expect_throw_with<InputError>([&] { cell_labels(f, "", dir + "/two.vtk"); }, "name the labels with prone.cell_labels");
+  expect_throw_with<InputError>([&] { cell_labels(f, "gland", dir + "/two.vtk"); }, "no one-component cell array 'gland'");
+  expect_throw_with<InputError>([&] { cell_labels(f, "quality", dir + "/two.vtk"); }, "not an integer");
+}
+
+TEST(MeshIoErrors, CellDataThatDoesNotFitTheCellsIsRefused) {
+  const std::string dir = temp_dir();
+  const std::string head = "# vtk DataFile Version 3.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n"
+                           "0 0 0\n10 0 0\n0 10 0\n0 0 10\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n";
+  write_text(dir + "/count.vtk", head + "CELL_DATA 2\nSCALARS label int 1\nLOOKUP_TABLE default\n1 2\n");
+  expect_throw_with<InputError>([&] { read_tet_mesh_file(dir + "/count.vtk", LengthUnit::Millimetre); },
+                                "CELL_DATA 2 does not match the 1 cells");
+  write_text(dir + "/short.vtk", head + "CELL_DATA 1\nSCALARS label int 1\nLOOKUP_TABLE default\n");
+  expect_throw_with<InputError>([&] { read_tet_mesh_file(dir + "/short.vtk", LengthUnit::Millimetre); }, "needs 1 values");
+  write_text(dir + "/none.vtk", head);
+  const TetMeshFile f = read_tet_mesh_file(dir + "/none.vtk", LengthUnit::Millimetre);
+  expect_throw_with<InputError>([&] { cell_labels(f, "", dir + "/none.vtk"); }, "no cell labels");
+  expect_throw_with<InputError>([&] { write_tet_mesh(dir + "/bad.vtk", f.mesh, LengthUnit::Millimetre, {1, 2}); },
+                                "2 cell labels for 1 tetrahedra");
+}

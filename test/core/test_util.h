@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 #include "breast_tumour_registration/core/rigid_transform.h"
@@ -23,6 +24,31 @@ inline std::string temp_dir() {
 }
 
 inline void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
+
+/// A scene folder's scene.yaml as text.
+inline std::string scene_text(const std::string& dir) {
+  std::ifstream in(dir + "/scene.yaml");
+  std::stringstream all;
+  all << in.rdbuf();
+  return all.str();
+}
+
+/// A YAML text without the lines (and their indented children) of a top-level key.
+inline std::string without_key(const std::string& text, const std::string& key) {
+  std::istringstream is(text);
+  std::string out, l;
+  bool skipping = false;
+  while (std::getline(is, l)) {
+    if (l.rfind(key + ":", 0) == 0) {
+      skipping = true;
+      continue;
+    }
+    if (skipping && !l.empty() && (l[0] == ' ' || l[0] == '-')) continue;
+    skipping = false;
+    out += l + "\n";
+  }
+  return out;
+}
 
 /// Runs f and expects it to throw E whose message contains `needle`.
 template <class E, class F>

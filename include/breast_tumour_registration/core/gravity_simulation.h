@@ -18,8 +18,10 @@ struct GravityProblem {
   double poisson_ratio = 0.49;
   double density = 1000;              ///< [kg/m^3]
   Vec3 gravity = Vec3(0, 0, -9.81);   ///< [m/s^2]
-  std::vector<int> inclusion;         ///< tetrahedra with their own Young's modulus (e.g. a stiff tumour)
-  double inclusion_youngs_modulus = 0;  ///< [Pa], same Poisson's ratio
+  /// Heterogeneous tissue: per tetrahedron 0 (youngs_modulus) or k >= 1 (region_youngs_modulus[k - 1]),
+  /// all with the same Poisson's ratio; empty: homogeneous.
+  std::vector<int> material_of;
+  std::vector<double> region_youngs_modulus;  ///< [Pa]
   VolumeForm volume_form = VolumeForm::Auto;  ///< see elastic_energy.h
 };
 

@@ -3,7 +3,9 @@
 // is applied here, once: everything returned is in metres.
 #pragma once
 
+#include <map>
 #include <string>
+#include <vector>
 
 #include "breast_tumour_registration/core/types.h"
 #include "breast_tumour_registration/core/units.h"
@@ -22,11 +24,25 @@ void write_surface(const std::string& path, const SurfaceMesh& mesh, LengthUnit 
 /// a .ply or .obj (faces, if any, are ignored). Throws InputError for no points or NaN.
 Points read_point_cloud(const std::string& path, LengthUnit unit);
 
+/// A tetrahedral mesh file with its one-component cell data, one value per tetrahedron:
+/// legacy VTK CELL_DATA SCALARS and FIELD arrays by name, Medit's element references as "ref".
+struct TetMeshFile {
+  TetMesh mesh;
+  std::map<std::string, std::vector<double>> cell_arrays;
+};
+
 /// Reads a tetrahedral mesh from legacy VTK (.vtk, ASCII unstructured grid,
-/// cell type 10) or Medit (.mesh). Non-tetrahedral cells are an error.
+/// cell type 10) or Medit (.mesh). Non-tetrahedral cells are an error (vertex, line and
+/// triangle cells are skipped, with their cell data).
+TetMeshFile read_tet_mesh_file(const std::string& path, LengthUnit unit);
+/// The mesh of read_tet_mesh_file.
 TetMesh read_tet_mesh(const std::string& path, LengthUnit unit);
-/// Writes legacy VTK (.vtk) or Medit (.mesh).
-void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit);
+/// Integer cell labels (e.g. tissue regions) from the cell array `array`; empty `array`: the
+/// file's only cell array. InputError naming `path` when it is missing, ambiguous or not integer.
+std::vector<int> cell_labels(const TetMeshFile& file, const std::string& array, const std::string& path);
+/// Writes legacy VTK (.vtk) or Medit (.mesh); `labels` (one per tetrahedron, or empty) go to
+/// CELL_DATA "label" or the Medit element references.
+void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit, const std::vector<int>& labels = {});
 
 /// Lower-case extension including the dot (".obj"); empty when there is none.
 std::string file_extension(const std::string& path);

@@ -23,6 +23,11 @@ struct PhantomOptions {
   double tumour_radius = 0.010;  ///< [m]
   int tumour_subdivisions = 3;
   double ring_width = 0.04;      ///< width of the chest-skin ring around the base [m]
+  /// Fibroglandular region: an ellipsoid centred on the breast's axis at gland_centre_z times
+  /// the height, with semi-axes gland_axes times (a, b, height); used when a generating
+  /// material gives it its own stiffness (PhantomSceneOptions::gland_youngs_modulus).
+  double gland_centre_z = 0.45;
+  Vec3 gland_axes = Vec3(0.45, 0.45, 0.30);
 };
 
 struct PhantomModel {
@@ -31,6 +36,7 @@ struct PhantomModel {
   std::vector<int> chest_wall;                ///< tet vertices on the base plane (fixed)
   SurfaceMesh chest_ring;                     ///< rigid chest skin (no FEM; for rigid alignment)
   std::map<std::string, SurfaceMesh> tumours; ///< rest tumour spheres: top, middle, bottom, left, right
+  SurfaceMesh gland;                          ///< rest fibroglandular region (closed; empty for a model read without one)
   std::map<std::string, int> landmarks;       ///< C, O1-O4, Oa-Od, I1-I4 -> tet boundary vertex
   Vec3 prone_gravity = Vec3(0, 0, 9.81);      ///< [m/s^2] model frame: the phantom lies prone towards +z
   Vec3 supine_gravity = Vec3(0, 0, -9.81);    ///< [m/s^2] model frame

@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "breast_tumour_registration/core/newton_solver.h"
 #include "breast_tumour_registration/core/phantom.h"
@@ -26,7 +27,16 @@ struct PhantomSceneOptions {
   /// > 0: the tumours' elements get this Young's modulus when generating prone and supine
   /// (real tumours are stiffer than the breast, thesis Ch. 6); 0: homogeneous.
   double tumour_youngs_modulus = 0;
+  /// > 0: the fibroglandular region (PhantomModel::gland) gets this Young's modulus (real
+  /// glandular tissue is about 2x stiffer than fat); 0: the body's material.
+  double gland_youngs_modulus = 0;
 };
+
+/// Cell labels of a heterogeneous phantom's tetrahedra (fat everywhere, then gland, then
+/// tumour, by centroid): what prone.vtk carries and the scene's regions refer to.
+constexpr int kPhantomFatLabel = 1, kPhantomGlandLabel = 2, kPhantomTumourLabel = 3;
+/// The labels the generating materials of `opt` call for; empty when homogeneous.
+std::vector<int> phantom_tissue_labels(const PhantomModel& model, const PhantomSceneOptions& opt);
 
 struct PhantomSceneSummary {
   long vertices = 0, tetrahedra = 0, chest_wall_vertices = 0;
@@ -42,6 +52,7 @@ struct PhantomConfigurations {
   Points prone, supine;
   NewtonResult prone_newton, supine_newton;
   std::map<std::string, SurfaceMesh> tumour_prone, tumour_supine;
+  std::vector<int> labels;  ///< phantom_tissue_labels (empty: homogeneous)
 };
 
 /// Simulates the configurations of `model` with the generating material of `opt` (the

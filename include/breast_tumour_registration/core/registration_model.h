@@ -82,8 +82,10 @@ struct RegistrationModel {
   std::vector<int> chest_wall;     ///< fixed vertices
   std::vector<bool> fixed;         ///< #V flags
   std::vector<int> skin;           ///< boundary vertices that are not fixed
-  std::vector<StableNeoHookean> materials;
-  std::vector<int> material_of;    ///< per tetrahedron
+  std::vector<StableNeoHookean> materials;  ///< [0] the body's; then regions' and the tumours' (material_regions.h)
+  std::vector<int> material_of;    ///< per tetrahedron, into materials
+  std::vector<std::string> material_names;  ///< per material: "body", a region's name, "tumour"
+  std::vector<long> material_tetrahedra;    ///< per material: how many tetrahedra have it
   MaterialParameters material;
   VolumeForm volume_form = VolumeForm::Element;  ///< resolved from material (never Auto)
   double volume = 0;               ///< [m^3]
@@ -101,8 +103,12 @@ RegistrationModel make_registration_model(const TetMesh& prone, const std::vecto
 int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceMesh& tumour);
 
 /// Gives the tetrahedra whose centroid lies inside any tumour the material with Young's
-/// modulus `youngs_modulus` (same nu); addresses the thesis's flattened tumours (Ch. 6).
+/// modulus `youngs_modulus` (same nu), over any region's; addresses the thesis's flattened
+/// tumours (Ch. 6). Appends the material "tumour".
 void stiffen_tumours(RegistrationModel& model, double youngs_modulus);
+
+/// Recounts model.material_tetrahedra from model.material_of.
+void count_material_tetrahedra(RegistrationModel& model);
 
 /// The model's elastic energy (material, volume form) added to `energy`: what every step simulates.
 void add_model_elastic_energy(TotalEnergy& energy, const RegistrationModel& model);

@@ -16,7 +16,12 @@
 //   material: {youngs_modulus: 3400, poisson_ratio: 0.49, density: 1000}
 //                                  # youngs_modulus: estimate (with prone_gravity and >= 3 landmarks):
 //                                  # the step `stiffness` finds it, in youngs_modulus_range: [150, 24000]
-//   tumour_material: {youngs_modulus: 17000}   # optional: stiffer tumour
+//   regions:                       # optional: per-element materials (material_regions.h), later wins
+//     - {name: gland, label: 2, youngs_modulus: 6800}          # cell label of prone.tet_mesh
+//     - {name: gland, surface: gland.obj, relative_stiffness: 2} # or a closed surface (model frame);
+//                                  # relative_stiffness: times material.youngs_modulus (scaled with an estimate)
+//                                  # prone.cell_labels: names the cell array when the file has several
+//   tumour_material: {youngs_modulus: 17000}   # optional: stiffer tumour (over any region)
 //   gravity: [0, 0, -9.81]         # supine gravity in the prone model frame [m/s^2] (required)
 //   prone_gravity: [0, 0, 9.81]    # optional: the gravity the prone image was taken under, same
 //                                  # frame; given, the step `unload` estimates the stress-free shape
@@ -31,6 +36,7 @@
 #include <vector>
 
 #include "breast_tumour_registration/core/energy_term.h"
+#include "breast_tumour_registration/core/material_regions.h"
 #include "breast_tumour_registration/core/registration_model.h"
 #include "breast_tumour_registration/core/rigid_transform.h"
 #include "breast_tumour_registration/core/units.h"
@@ -71,6 +77,8 @@ struct Scene {
   std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
   std::vector<SceneTumour> tumours;
   MaterialParameters material;
+  std::vector<MaterialRegion> regions;   ///< per-element materials, in order (later wins)
+  std::vector<int> prone_labels;         ///< cell label per prone tetrahedron, when a region selects by label
   std::optional<double> tumour_youngs_modulus;
   /// `youngs_modulus: estimate`: the range [Pa] the stiffness step searches (material.youngs_modulus
   /// is then only the reference the other materials are given relative to).

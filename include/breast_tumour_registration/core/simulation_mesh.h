@@ -9,7 +9,8 @@
 namespace btr {
 
 /// The scene with its prone model re-tetrahedralized at `cell_size` [m]: the chest wall is
-/// found again on the new boundary and the landmarks are re-attached as barycentric anchors;
+/// found again on the new boundary and the landmarks are re-attached as barycentric anchors,
+/// the cell labels carried over (transfer_cell_labels);
 /// all other data is unchanged (prepare_model embeds the tumours in the new mesh). Throws
 /// InputError for cell_size <= 0 or a prone boundary that cannot be meshed.
 Scene with_simulation_mesh(const Scene& scene, double cell_size);
