@@ -162,7 +162,8 @@ class Body:
 def write_scenes(d, fat_e, gland_ratio, tumour_ratio):
     common = ['units: mm', 'prone: {surface: prone.obj}', 'chest_wall: chest_wall.txt', 'landmarks: landmarks.csv',
               'supine: {surface: supine.obj}', 'tumours:']
-    names = sorted(n[len('tumour_'):-len('_prone.obj')] for n in os.listdir(d) if n.endswith('_prone.obj'))
+    names = sorted(n[len('tumour_'):-len('_prone.obj')] for n in os.listdir(d)
+                   if n.startswith('tumour_') and n.endswith('_prone.obj'))
     common += ['  - {name: %s, prone: tumour_%s_prone.obj, supine_ground_truth: tumour_%s_supine.obj}' % (n, n, n)
                for n in names]
     common += ['gravity: [0, 0, -9.81]', 'preset: balanced']

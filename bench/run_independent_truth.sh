@@ -1,8 +1,9 @@
 #!/bin/bash
 # The method on truth made by an independent FEM code (SfePy, P2, heterogeneous): generates the
 # configurations (bench/make_independent_truth.py), registers each with the prone shape as rest
-# (the thesis), unloaded at the assumed 3400 Pa, and unloaded at an estimated E, and prints a
-# markdown table of the worst tumour error. Needs python3-sfepy and tetgen (Debian):
+# (the thesis), unloaded at the assumed 3400 Pa, and unloaded at an estimated E, each homogeneous
+# and (the last two) with the tissue regions, and prints a markdown table of the worst tumour
+# error, then per fat E the tumours' shape (bench/summarize_tumours.py). Needs python3-sfepy and tetgen (Debian):
 #   apt-get install -y python3-sfepy tetgen
 # Usage: bash bench/run_independent_truth.sh OUT [fat E [Pa] ...]   (default 300 1000 3400)
 set -euo pipefail
@@ -16,7 +17,7 @@ set -u
 for E in $MODULI; do
   [ -f "$OUT/E$E/truth.json" ] || PYTHONUNBUFFERED=1 /usr/bin/python3 "$here/make_independent_truth.py" "$OUT" \
     --fat-youngs-moduli "$E" --max-volume "${MAX_VOLUME:-5000}"
-  for v in prone unloaded estimated; do
+  for v in prone unloaded estimated unloaded_regions estimated_regions; do
     rosrun breast_tumour_registration btr_register "$OUT/E$E/scene_$v.yaml" --quiet --out "$OUT/E$E/reg_$v" \
       > "$OUT/E$E/reg_$v.log" 2>&1 || true  # exit 4/5 (not converged / implausible) still writes the report
   done
@@ -45,3 +46,9 @@ for E in moduli:
     print('| %s | %.1f | %s | %s | %s | %s | %s | %s |' % (E, truth['prone']['max_displacement_mm'],
           '%.2f' % rigid if rigid is not None else '-', row['prone'], row['unloaded'], row['estimated'], est, secs))
 PY
+for E in $MODULI; do
+  d=$OUT/E$E
+  echo "### fat E = $E Pa: tumour shape"
+  /usr/bin/python3 "$here/summarize_tumours.py" $(for v in prone unloaded estimated unloaded_regions estimated_regions; do
+    echo "$v=$d/reg_$v/report.json"; done)
+done

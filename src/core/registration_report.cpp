@@ -44,9 +44,13 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
     << ",\n  \"mesh\": {\"vertices\": " << model.rest.V.rows() << ", \"tetrahedra\": " << model.rest.T.rows()
     << ", \"chest_wall_vertices\": " << model.chest_wall.size() << ", \"skin_vertices\": " << model.skin.size()
     << ", \"stiff_tumour_tetrahedra\": " << model.stiff_tetrahedra << "},\n";
+  // The prepared model's materials; the stiffness step scales them all by one factor.
+  const double scale = r.steps.stiffness && r.estimated_youngs_modulus > 0
+                           ? r.estimated_youngs_modulus / model.material.youngs_modulus
+                           : 1.0;
   j << "  \"materials\": [";
   for (size_t i = 0; i < model.materials.size(); ++i) {
-    const double mu = model.materials[i].mu(), lambda_lame = model.materials[i].lambda() - mu;
+    const double mu = scale * model.materials[i].mu(), lambda_lame = scale * model.materials[i].lambda() - mu;
     j << (i ? ", " : "") << "{\"name\": " << quote(i < model.material_names.size() ? model.material_names[i] : "")
       << ", \"youngs_modulus_Pa\": " << num(mu * (3 * lambda_lame + 2 * mu) / (lambda_lame + mu))
       << ", \"tetrahedra\": " << (i < model.material_tetrahedra.size() ? model.material_tetrahedra[i] : 0) << "}";

@@ -144,3 +144,22 @@ TEST(MaterialRegions, BadRegionsAreClearErrors) {
                    "supine: {surface: supine_surface.obj}\nregions: [{name: gland, label: 2, youngs_modulus: 5}]\n");
   expect_throw_with<InputError>([&] { load_scene(surf); }, "needs prone.tet_mesh");
 }
+
+TEST(MaterialRegions, AnEstimatedStiffnessScalesEveryRegion) {
+  // Relative stiffness: the estimate moves the body's E and the regions keep their ratios.
+  const std::string path = labelled_phantom_dir() + "/estimate.yaml";
+  write_text(path, without_key(scene_text(labelled_phantom_dir()), "material") +
+                       "material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]\n");
+  const Scene s = load_scene(path);
+  std::vector<std::string> w;
+  const RegistrationModel m = prepare_model(s, w);
+  const RegistrationResult r = run_registration(s, m, preset_options("balanced"));
+  std::printf("labelled 3400 Pa phantom, E estimated: %.0f Pa, worst tumour %.4f mm\n", r.estimated_youngs_modulus,
+              [&] { double x = 0; for (const auto& t : r.tumours) x = std::max(x, t.centroid_distance); return x * 1e3; }());
+  EXPECT_NEAR(r.estimated_youngs_modulus, 3400, 340);
+  const std::string json = registration_report_json(s, m, r, 0);
+  const auto at = json.find("{\"name\": \"gland\", \"youngs_modulus_Pa\": ");
+  ASSERT_NE(at, std::string::npos) << json.substr(0, 1200);
+  const double gland_E = std::stod(json.substr(at + 38));
+  EXPECT_NEAR(gland_E / r.estimated_youngs_modulus, 2.0, 1e-5);  // the report prints 6 digits
+}
