@@ -8,7 +8,7 @@
 
 #include "breast_tumour_registration/core/errors.h"
 #include "breast_tumour_registration/core/index_io.h"
-#include "breast_tumour_registration/core/material_regions.h"
+#include "breast_tumour_registration/core/material_region.h"
 #include "breast_tumour_registration/core/mesh_io.h"
 #include "breast_tumour_registration/core/surface_attachment.h"
 #include "breast_tumour_registration/core/surface_orientation.h"

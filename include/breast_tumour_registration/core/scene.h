@@ -36,7 +36,7 @@
 #include <vector>
 
 #include "breast_tumour_registration/core/energy_term.h"
-#include "breast_tumour_registration/core/material_regions.h"
+#include "breast_tumour_registration/core/material_region.h"
 #include "breast_tumour_registration/core/registration_model.h"
 #include "breast_tumour_registration/core/rigid_transform.h"
 #include "breast_tumour_registration/core/units.h"
