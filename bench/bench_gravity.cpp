@@ -10,9 +10,9 @@
 #include <cstdio>
 #include <vector>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/gravity_simulation.h"
-#include "breast_tumour_registration/core/phantom.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/simulation/phantom.h"
 
 using namespace btr;
 

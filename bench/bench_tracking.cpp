@@ -11,12 +11,12 @@
 #include <fstream>
 #include <string>
 
-#include "breast_tumour_registration/core/depth_camera.h"
-#include "breast_tumour_registration/core/depth_tracker.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/phantom_scene.h"
-#include "breast_tumour_registration/core/scene.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/io/scene.h"
+#include "breast_tumour_registration/registration/depth_tracker.h"
+#include "breast_tumour_registration/simulation/depth_camera.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 
 using namespace btr;
 

@@ -16,9 +16,9 @@
 #include <sstream>
 #include <vector>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/registration_pipeline.h"
-#include "breast_tumour_registration/core/simulation_mesh.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/simulation_mesh.h"
 
 using namespace btr;
 

@@ -11,11 +11,11 @@
 #include <cstdio>
 #include <fstream>
 
-#include "breast_tumour_registration/core/depth_camera.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/metrics.h"
-#include "breast_tumour_registration/core/scene.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/io/scene.h"
 #include "breast_tumour_registration/ros/converters.h"
+#include "breast_tumour_registration/simulation/depth_camera.h"
 
 using namespace btr;
 

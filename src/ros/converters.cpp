@@ -6,7 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/base/errors.h"
 
 namespace btr::ros_conv {
 

@@ -10,9 +10,9 @@
 #include <chrono>
 
 #include "breast_tumour_registration/RegistrationResult.h"
-#include "breast_tumour_registration/core/depth_camera.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/registration/live_scene.h"
 #include "breast_tumour_registration/ros/converters.h"
 
 namespace btr {
@@ -306,29 +306,12 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       if (tracked < params_.min_tracked_clouds)
         throw NotReady("the depth tracking is settling (" + std::to_string(tracked) + " of " +
                        std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
-      if (w > 0) {
-        scene.supine_surface = triangulate_organized(cloud, w, h, params_.max_depth_edge);
-      } else {
-        // Unorganized cloud: project onto the points themselves (PCA normals).
-        Points finite(cloud.rows(), 3);
-        Eigen::Index k = 0;
-        for (Eigen::Index i = 0; i < cloud.rows(); ++i)
-          if (cloud.row(i).allFinite()) finite.row(k++) = cloud.row(i);
-        finite.conservativeResize(k, 3);
-        scene.supine_surface.reset();
-        scene.supine_cloud = finite;
-      }
-      // The scene's supine data (landmarks, ground truth) is in the model's supine frame:
-      // place it in the working frame with the tracked alignment.
-      if (params_.use_landmarks && scene.landmark_supine.rows()) scene.landmark_supine = transform_points(*T, scene.landmark_supine);
-      else {
-        scene.landmark_anchors.clear();
-        scene.landmark_supine.resize(0, 3);
-      }
-      for (auto& t : scene.tumours)
-        if (t.supine_ground_truth) t.supine_ground_truth = transform_surface(*T, *t.supine_ground_truth);
-      scene.steps.clear();
-      opt.known_supine_to_model = T->inverse();
+      LiveSceneOptions lo;
+      lo.max_depth_edge = params_.max_depth_edge;
+      lo.use_landmarks = params_.use_landmarks;
+      LiveScene live = live_scene(scene, LiveScan{std::move(cloud), w, h, *T}, lo);
+      scene = std::move(live.scene);
+      opt.known_supine_to_model = live.known_supine_to_model;
     }
     publish_status(diagnostic_msgs::DiagnosticStatus::OK, "registration running (" + preset + ")");
     struct Flag {

@@ -10,11 +10,11 @@
 #include <filesystem>
 #include <fstream>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/experiment_shards.h"
-#include "breast_tumour_registration/core/experiment_suite.h"
-#include "breast_tumour_registration/core/registration_pipeline.h"
-#include "breast_tumour_registration/core/rest_model_io.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/simulation/experiment_shards.h"
+#include "breast_tumour_registration/simulation/experiment_suite.h"
+#include "breast_tumour_registration/simulation/rest_model_io.h"
 
 namespace fs = std::filesystem;
 using namespace btr;

@@ -10,8 +10,8 @@
 #include <fstream>
 #include <iostream>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/phantom_scene.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 
 namespace fs = std::filesystem;
 using namespace btr;

@@ -11,8 +11,8 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/registration_report.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/simulation/registration_report.h"
 
 using namespace btr;
 

@@ -4,12 +4,12 @@
 #include <algorithm>
 #include <random>
 
-#include "breast_tumour_registration/core/depth_camera.h"
-#include "breast_tumour_registration/core/depth_tracker.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/metrics.h"
-#include "breast_tumour_registration/core/nearest_sample_grid.h"
-#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/geometry/nearest_sample_grid.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/registration/depth_tracker.h"
+#include "breast_tumour_registration/simulation/depth_camera.h"
 #include "test_util.h"
 
 using namespace btr;

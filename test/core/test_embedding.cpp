@@ -1,8 +1,8 @@
 #include <random>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/embedding.h"
-#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
+#include "breast_tumour_registration/geometry/embedding.h"
 #include "test_util.h"
 
 using namespace btr;

@@ -2,17 +2,17 @@
 #include <memory>
 #include <random>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/elastic_energy.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/gravity_energy.h"
-#include "breast_tumour_registration/core/newton_solver.h"
-#include "breast_tumour_registration/core/nodal_volume_energy.h"
-#include "breast_tumour_registration/core/plane_constraint_energy.h"
-#include "breast_tumour_registration/core/point_constraint_energy.h"
-#include "breast_tumour_registration/core/rigid_free_landmark_energy.h"
-#include "breast_tumour_registration/core/rigid_free_surface_energy.h"
-#include "breast_tumour_registration/core/total_energy.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/elastic_energy.h"
+#include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/fem/newton_solver.h"
+#include "breast_tumour_registration/fem/nodal_volume_energy.h"
+#include "breast_tumour_registration/fem/plane_constraint_energy.h"
+#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/rigid_free_landmark_energy.h"
+#include "breast_tumour_registration/fem/rigid_free_surface_energy.h"
+#include "breast_tumour_registration/fem/total_energy.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
 #include "test_util.h"
 
 using namespace btr;

@@ -10,12 +10,12 @@
 #include <map>
 #include <sstream>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/experiment_shards.h"
-#include "breast_tumour_registration/core/experiment_suite.h"
-#include "breast_tumour_registration/core/index_io.h"
-#include "breast_tumour_registration/core/rest_model_io.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/simulation/experiment_shards.h"
+#include "breast_tumour_registration/simulation/experiment_suite.h"
+#include "breast_tumour_registration/simulation/rest_model_io.h"
 #include "test_util.h"
 
 namespace btr {

@@ -2,12 +2,12 @@
 // energy and either converges or stops with a stated reason; never NaN, never a hang.
 #include <memory>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/elastic_energy.h"
-#include "breast_tumour_registration/core/gravity_energy.h"
-#include "breast_tumour_registration/core/newton_solver.h"
-#include "breast_tumour_registration/core/point_constraint_energy.h"
-#include "breast_tumour_registration/core/tet_kinematics.h"
+#include "breast_tumour_registration/fem/elastic_energy.h"
+#include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/fem/newton_solver.h"
+#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
 #include "test_util.h"
 
 using namespace btr;

@@ -5,7 +5,7 @@
 // the method's mesh type and material; this one shares neither.
 #include <string>
 
-#include "breast_tumour_registration/core/registration_pipeline.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "test_util.h"
 
 using namespace btr;

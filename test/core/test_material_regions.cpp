@@ -4,13 +4,13 @@
 #include <filesystem>
 #include <set>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/material_regions.h"
-#include "breast_tumour_registration/core/mesh_io.h"
-#include "breast_tumour_registration/core/phantom_scene.h"
-#include "breast_tumour_registration/core/registration_pipeline.h"
-#include "breast_tumour_registration/core/registration_report.h"
-#include "breast_tumour_registration/core/simulation_mesh.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/io/mesh_io.h"
+#include "breast_tumour_registration/registration/material_regions.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/simulation_mesh.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
+#include "breast_tumour_registration/simulation/registration_report.h"
 #include "test_util.h"
 
 using namespace btr;

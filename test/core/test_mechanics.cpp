@@ -1,8 +1,8 @@
 // Closed-form checks of the FEM against small-strain elasticity.
 #include <memory>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/gravity_simulation.h"
+#include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
 #include "test_util.h"
 
 using namespace btr;

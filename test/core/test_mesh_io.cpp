@@ -1,11 +1,11 @@
 #include <cstdint>
 #include <cstring>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/index_io.h"
-#include "breast_tumour_registration/core/mesh_io.h"
-#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "test_util.h"
 
 using namespace btr;

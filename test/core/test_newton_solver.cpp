@@ -1,11 +1,11 @@
 #include <memory>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/elastic_energy.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/gravity_energy.h"
-#include "breast_tumour_registration/core/newton_solver.h"
-#include "breast_tumour_registration/core/validation.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/elastic_energy.h"
+#include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/fem/newton_solver.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
+#include "breast_tumour_registration/geometry/validation.h"
 #include "test_util.h"
 
 using namespace btr;

@@ -1,12 +1,12 @@
 #include <set>
 
-#include "breast_tumour_registration/core/embedding.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/gravity_simulation.h"
-#include "breast_tumour_registration/core/phantom.h"
-#include "breast_tumour_registration/core/shapes.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
-#include "breast_tumour_registration/core/validation.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/geometry/validation.h"
+#include "breast_tumour_registration/simulation/phantom.h"
 #include "test_util.h"
 
 using namespace btr;

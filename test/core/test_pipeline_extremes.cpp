@@ -7,15 +7,15 @@
 #include <fstream>
 #include <sstream>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/index_io.h"
-#include "breast_tumour_registration/core/mesh_io.h"
-#include "breast_tumour_registration/core/phantom.h"
-#include "breast_tumour_registration/core/phantom_scene.h"
-#include "breast_tumour_registration/core/registration_pipeline.h"
-#include "breast_tumour_registration/core/rigid_regions.h"
-#include "breast_tumour_registration/core/shapes.h"
-#include "breast_tumour_registration/core/tet_kinematics.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/rigid_regions.h"
+#include "breast_tumour_registration/simulation/phantom.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "test_util.h"
 
 using namespace btr;

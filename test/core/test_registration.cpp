@@ -5,17 +5,17 @@
 #include <random>
 #include <sstream>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/icp_alignment.h"
-#include "breast_tumour_registration/core/index_io.h"
-#include "breast_tumour_registration/core/mesh_io.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
-#include "breast_tumour_registration/core/phantom_scene.h"
-#include "breast_tumour_registration/core/registration_report.h"
-#include "breast_tumour_registration/core/shapes.h"
-#include "breast_tumour_registration/core/surface_projector.h"
-#include "breast_tumour_registration/core/simulation_mesh.h"
-#include "breast_tumour_registration/core/skinning_subspace.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/skinning_subspace.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/geometry/surface_projector.h"
+#include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
+#include "breast_tumour_registration/registration/icp_alignment.h"
+#include "breast_tumour_registration/registration/simulation_mesh.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
+#include "breast_tumour_registration/simulation/registration_report.h"
 #include "test_util.h"
 
 using namespace btr;

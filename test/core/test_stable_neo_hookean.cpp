@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <random>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/stable_neo_hookean.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/stable_neo_hookean.h"
 #include "test_util.h"
 
 using namespace btr;

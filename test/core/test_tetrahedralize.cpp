@@ -1,8 +1,8 @@
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/shapes.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
-#include "breast_tumour_registration/core/tetrahedralize.h"
-#include "breast_tumour_registration/core/validation.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/geometry/tetrahedralize.h"
+#include "breast_tumour_registration/geometry/validation.h"
 #include "test_util.h"
 
 using namespace btr;

@@ -6,11 +6,11 @@
 #include <cmath>
 #include <cstdio>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/phantom.h"
-#include "breast_tumour_registration/core/phantom_scene.h"
-#include "breast_tumour_registration/core/tet_kinematics.h"
-#include "breast_tumour_registration/core/unloaded_shape.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+#include "breast_tumour_registration/fem/unloaded_shape.h"
+#include "breast_tumour_registration/simulation/phantom.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 
 using namespace btr;
 

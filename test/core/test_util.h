@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "breast_tumour_registration/core/rigid_transform.h"
+#include "breast_tumour_registration/geometry/rigid_transform.h"
 
 namespace btr::test {
 

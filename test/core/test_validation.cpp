@@ -1,10 +1,10 @@
 #include <cmath>
 #include <limits>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/shapes.h"
-#include "breast_tumour_registration/core/validation.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
+#include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/geometry/validation.h"
 #include "test_util.h"
 
 using namespace btr;

@@ -14,7 +14,7 @@
 
 #include <unistd.h>
 
-#include "breast_tumour_registration/core/errors.h"
+#include "breast_tumour_registration/base/errors.h"
 
 namespace btr::fuzz {
 

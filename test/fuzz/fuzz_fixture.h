@@ -5,10 +5,10 @@
 
 #include <string>
 
-#include "breast_tumour_registration/core/box_mesh.h"
-#include "breast_tumour_registration/core/index_io.h"
-#include "breast_tumour_registration/core/mesh_io.h"
-#include "breast_tumour_registration/core/surface_attachment.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "fuzz_common.h"
 
 namespace btr::fuzz {

@@ -1,5 +1,5 @@
 // Index lists (chest wall), landmark pair CSVs and named index files.
-#include "breast_tumour_registration/core/index_io.h"
+#include "breast_tumour_registration/io/index_io.h"
 #include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

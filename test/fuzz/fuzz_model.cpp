@@ -1,6 +1,6 @@
 // The rest-model loader (model.yaml of btr_experiments --model) and the files it names
 // (a small valid body is on disk beside the input, see fuzz_fixture.h).
-#include "breast_tumour_registration/core/rest_model_io.h"
+#include "breast_tumour_registration/simulation/rest_model_io.h"
 #include "fuzz_fixture.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,7 +1,7 @@
 // The scene loader (YAML): keys, types, units, gravity, steps, and the files it names
 // (a small valid body is on disk beside the input, see fuzz_fixture.h). Meshing is left
 // out (tetrahedralize = false), so that a run costs parsing and checks, not CGAL.
-#include "breast_tumour_registration/core/scene.h"
+#include "breast_tumour_registration/io/scene.h"
 #include "fuzz_fixture.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -1,6 +1,6 @@
 // Surface and point-cloud readers (OBJ, PLY ASCII and binary, STL ASCII and binary, OFF,
 // VTK): the first byte chooses the format, the rest is the file.
-#include "breast_tumour_registration/core/mesh_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

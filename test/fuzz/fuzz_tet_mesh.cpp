@@ -1,6 +1,6 @@
 // Tetrahedral mesh readers (legacy VTK unstructured grid, Medit .mesh): the first byte
 // chooses the format, the rest is the file.
-#include "breast_tumour_registration/core/mesh_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "fuzz_common.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

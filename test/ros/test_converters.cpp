@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "breast_tumour_registration/core/errors.h"
-#include "breast_tumour_registration/core/shapes.h"
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/ros/converters.h"
 
 using namespace btr;

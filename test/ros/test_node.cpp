@@ -14,7 +14,7 @@
 #include <limits>
 
 #include "breast_tumour_registration/Register.h"
-#include "breast_tumour_registration/core/rigid_transform.h"
+#include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/ros/converters.h"
 
 namespace {

@@ -10,8 +10,8 @@
 
 #include <string>
 
-#include "breast_tumour_registration/core/rigid_transform.h"
-#include "breast_tumour_registration/core/types.h"
+#include "breast_tumour_registration/base/types.h"
+#include "breast_tumour_registration/geometry/rigid_transform.h"
 
 namespace btr::ros_conv {
 

@@ -21,8 +21,8 @@
 #include <string>
 
 #include "breast_tumour_registration/Register.h"
-#include "breast_tumour_registration/core/depth_tracker.h"
-#include "breast_tumour_registration/core/registration_pipeline.h"
+#include "breast_tumour_registration/registration/depth_tracker.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
 
 namespace btr {
 

@@ -1,0 +1,56 @@
+// The forward equilibrium of a body under gravity from a changing rest shape, solved many
+// times on one mesh: one Hessian assembler and Newton solver (so one CHOLMOD symbolic
+// analysis) for every solve, and load continuation when one load step does not converge (a
+// soft body sagging far: the gravity ramped up from zero in adaptive fractions, each solve
+// warm-started from the last). The unloaded-shape estimate and the stiffness estimate are
+// sequences of such solves.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "breast_tumour_registration/fem/elastic_energy.h"
+#include "breast_tumour_registration/fem/newton_solver.h"
+
+namespace btr {
+
+struct ForwardGravityOptions {
+  NewtonOptions newton;  ///< of each solve (force_scale 0: the body's weight)
+  /// The first load fraction of a continuation, grown 1.5x after a converged fraction and
+  /// halved after a failed one; below min_load_fraction the solve has failed.
+  double first_load_fraction = 0.25;
+  double min_load_fraction = 1.0 / 64;
+};
+
+class ForwardGravity {
+ public:
+  /// Throws InputError for a fixed vertex out of range or an unresolved volume form.
+  ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const std::vector<int>& fixed,
+                 std::vector<StableNeoHookean> materials, std::vector<int> material_of, VolumeForm volume_form,
+                 double density, ForwardGravityOptions options = {});
+
+  /// The equilibrium of rest shape X under `gravity` [m/s^2] with the fixed vertices at X's
+  /// positions; x is the start and receives the equilibrium. Returns the Newton iterations it
+  /// took; throws SolverError (x unchanged) when even the smallest load fraction fails.
+  int solve(const Points& X, const Vec3& gravity, Points& x);
+
+  bool is_fixed(Eigen::Index v) const { return fixed_[static_cast<size_t>(v)]; }
+  int newton_iterations() const { return newton_iterations_; }  ///< over all solves
+  int load_steps() const { return load_steps_; }                ///< continuation fractions solved, over all solves
+
+ private:
+  NewtonResult solve_once(const Points& X, const Vec3& gravity, Points& x);
+
+  TetMesh rest_;
+  std::vector<bool> fixed_;
+  std::vector<StableNeoHookean> materials_;
+  std::vector<int> material_of_;
+  VolumeForm volume_form_;
+  double density_;
+  ForwardGravityOptions opt_;
+  std::shared_ptr<HessianAssembler> assembler_;
+  std::unique_ptr<NewtonSolver> solver_;
+  int newton_iterations_ = 0, load_steps_ = 0;
+};
+
+}  // namespace btr

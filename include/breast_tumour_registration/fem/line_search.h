@@ -1,0 +1,30 @@
+// Backtracking (Armijo) line search shared by the full-space and subspace Newton solvers:
+// never accepts an energy increase, a non-finite energy, or (optionally) a state with more
+// inverted tetrahedra than the current one.
+#pragma once
+
+#include "breast_tumour_registration/fem/total_energy.h"
+
+namespace btr {
+
+struct LineSearchOptions {
+  int max_steps = 40;
+  double armijo = 1e-4;
+  bool forbid_new_inversions = true;
+};
+
+struct LineSearchResult {
+  bool accepted = false;
+  double alpha = 0;
+  double energy = 0;
+  long inverted = 0;
+};
+
+/// Tries x + alpha dx for alpha = 1, 1/2, ...; on acceptance x_out holds the new state.
+/// E0, slope (= g . dx, negative for descent) and inverted0 describe the current state x;
+/// T (may be empty) is used to count inverted tetrahedra.
+LineSearchResult backtracking_line_search(const TotalEnergy& energy, const Points& x, const Points& dx, double E0,
+                                          double slope, long inverted0, const Tetrahedra& T,
+                                          const LineSearchOptions& opt, Points& x_out);
+
+}  // namespace btr

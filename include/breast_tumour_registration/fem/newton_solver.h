@@ -1,0 +1,168 @@
+// Quasi-static Newton solver (thesis Sec. 3.2): minimizes a TotalEnergy over the free
+// vertices with a PSD-projected Hessian, CHOLMOD supernodal Cholesky (symbolic analysis
+// once per solver, numeric factorization per iteration) and a backtracking line search.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/fem/hessian_pattern.h"
+#include "breast_tumour_registration/fem/total_energy.h"
+
+namespace btr {
+
+enum class StopReason {
+  GradientTolerance,  ///< |g| <= abs_tol + rel_tol max(|g0|, force_scale)   (converged)
+  StepTolerance,      ///< the full Newton step of a fresh factorization is below step_tolerance (converged:
+                      ///< the minimum of the Newton model is that close; the gradient is at round-off)
+  Stalled,            ///< damped line-search steps below step_tolerance while the full step is not (not converged)
+  InvertedAfterStall, ///< a stall let the line search invert elements and the solve ended with too many
+                      ///< inverted: the uninverted stall state is kept (not converged)
+  MaxIterations,      ///< iteration cap reached (not converged)
+  LineSearchFailed,   ///< no step decreased the energy even on a fresh factorization; state is the best found
+  Aborted,            ///< the callback asked to stop
+};
+std::string to_string(StopReason r);
+
+struct LineSearchOptions;
+
+struct IterationInfo {
+  int iteration = 0;
+  double energy = 0;         ///< after the step [J]
+  double gradient_norm = 0;  ///< free-DOF gradient 2-norm after the step [N]
+  double alpha = 0;          ///< accepted step length
+  double step_norm = 0;      ///< max vertex displacement of the accepted step [m]
+  long inverted = 0;         ///< inverted tetrahedra after the step
+  double elapsed = 0;        ///< seconds since the solve started
+  double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< this iteration [s]
+  bool factorized = false;  ///< this iteration factorized (false: PCG on the lagged factor)
+  int pcg_iterations = 0;
+};
+
+struct NewtonOptions {
+  int max_iterations = 100;
+  double gradient_rel_tolerance = 1e-6;  ///< relative to max(initial gradient norm, force_scale)
+  /// A physical force scale [N] (e.g. the body's weight) so that a warm start from a
+  /// near-solution is judged against the problem's forces, not its own tiny residual.
+  double force_scale = 0;
+  double gradient_abs_tolerance = 1e-10; ///< [N]
+  double step_tolerance = 1e-9;          ///< [m], on the full Newton step
+  int max_line_search_steps = 40;
+  double armijo = 1e-4;
+  bool project_psd = true;
+  /// With project_psd: once a full step was accepted and |g| is below 1% of the load, use the
+  /// unprojected Hessian (full-space solver only), back to the projected one if it is not
+  /// positive definite or its step makes no progress.
+  bool exact_hessian_near_solution = true;
+  /// Reuse the last Cholesky factor as a preconditioner for conjugate gradients on the
+  /// new Hessian (inexact Newton); refactorize only when PCG does not reach the forcing
+  /// tolerance within max_pcg_iterations. Off: a fresh factorization every iteration.
+  bool reuse_factorization = true;
+  int max_pcg_iterations = 25;
+  /// Forcing term of the inexact Newton step: |H d + g| <= eta |g| with
+  /// eta = min(max_forcing, sqrt(|g| / |g0|)) (superlinear convergence).
+  double max_forcing = 0.1;
+  /// Reject line-search steps that invert more tetrahedra than the current state has.
+  bool forbid_new_inversions = true;
+  /// When a stall lets the line search invert (recover_from_stall), the solve may end with at
+  /// most this fraction of the tetrahedra newly inverted (a few elements passing a nearly flat
+  /// state, reported); more means the mesh folded to meet its constraints, and the last
+  /// uninverted state is kept (StopReason::InvertedAfterStall).
+  double max_inverted_fraction_after_stall = 0.002;
+  /// Called after every accepted iteration; return false to abort.
+  std::function<bool(const IterationInfo&)> callback;
+};
+
+struct NewtonResult {
+  StopReason reason = StopReason::MaxIterations;
+  bool converged = false;
+  int iterations = 0;
+  double initial_energy = 0, energy = 0;
+  double initial_gradient_norm = 0, gradient_norm = 0;
+  long inverted = 0;
+  double seconds = 0;
+  double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< totals [s]
+  int regularizations = 0;  ///< factorizations that needed a diagonal shift
+  int factorizations = 0;    ///< numeric Cholesky factorizations
+  int pcg_iterations = 0;    ///< total preconditioned CG iterations (lagged-factor steps)
+  bool inversions_allowed = false;  ///< a stall made the line search accept new inversions
+  std::vector<IterationInfo> history;
+};
+
+/// Records an accepted iteration in `res` (history, totals), calls the callback and applies
+/// the stopping rules; returns true when the solve should stop (reason and converged set).
+/// Converged means the gradient criterion held (or, in the caller, a fresh full Newton step
+/// below step_tolerance); a damped step below it is a stall, never convergence.
+bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res);
+
+/// Outcome of trying a Newton direction.
+/// TooSmall: the full (undamped) step is below step_tolerance; Stalled: the line search
+/// accepted a step, but one below step_tolerance while the full step is not.
+enum class StepOutcome { Taken, TooSmall, NoDecrease, Stalled };
+
+/// After a direction that did not make progress (TooSmall, NoDecrease, Stalled), what a stall
+/// calls for, in order: a direction from the lagged factor is retried on a fresh
+/// factorization; then a line search that refused new inversions may invert elements (the
+/// stable Neo-Hookean energy is defined there; opt.forbid_new_inversions is cleared and
+/// res.inversions_allowed set). Returns true when the caller should retry (refactorizing);
+/// otherwise sets the final reason in res (StepTolerance, converged; LineSearchFailed or
+/// Stalled, not converged) and returns false.
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res);
+
+/// The state at which a stall let the line search invert elements (recover_from_stall). A solve
+/// that then ends with more than max_inverted_fraction_after_stall of its tetrahedra newly
+/// inverted folded the mesh to meet its constraints (landmarks pulled through the chest
+/// wall): the state is restored and the solve reported as InvertedAfterStall. One that ends
+/// within it keeps its result, and the count is reported (soft tissue whose prone shape
+/// stands in for the rest shape: 1 to 6 of 7.1k elements at E = 400 Pa).
+struct InversionGuard {
+  bool armed = false;
+  Points x;
+  double energy = 0;
+  long inverted = 0;
+  /// Records the state the first time res.inversions_allowed is set.
+  void arm(const NewtonResult& res, const Points& x_now, double E, long n_inv);
+  /// At the end of a solve: restores the recorded state when x has more than
+  /// max_fraction x n_tets inversions beyond it; returns true when it did (x, E, n_inv and res
+  /// updated; the caller recomputes |g|).
+  bool restore_if_worse(Points& x_now, double& E, long& n_inv, NewtonResult& res, long n_tets, double max_fraction) const;
+};
+
+/// Shared by the full-space and subspace solvers: takes the step dx (#V by 3) with the line
+/// search from x (energy E, n_inv inverted tetrahedra), updating x, E, n_inv, the iteration's
+/// alpha / step norm / line-search time and the result's time totals. TooSmall: the full step
+/// is below the step tolerance (converged); NoDecrease: the line search found no decrease.
+StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
+                              const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
+                              long& n_inv, IterationInfo& info, NewtonResult& res);
+
+/// The line-search part of the options.
+LineSearchOptions line_search_options(const NewtonOptions& opt);
+
+/// Newton solver bound to one sparsity pattern: the CHOLMOD symbolic analysis is done on
+/// the first solve and reused by every later solve with the same assembler.
+class NewtonSolver {
+ public:
+  /// tets are used only to count inversions for the line search (may be empty).
+  NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets);
+  ~NewtonSolver();
+  NewtonSolver(const NewtonSolver&) = delete;
+  NewtonSolver& operator=(const NewtonSolver&) = delete;
+
+  /// Minimizes energy over the free vertices of x in place; fixed vertices keep their
+  /// positions. Throws SolverError if the energy is not finite at the start or the
+  /// Hessian cannot be factorized even after regularization.
+  NewtonResult solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt);
+
+  HessianAssembler& assembler() { return *assembler_; }
+
+ private:
+  struct Impl;
+  std::shared_ptr<HessianAssembler> assembler_;
+  Tetrahedra tets_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace btr

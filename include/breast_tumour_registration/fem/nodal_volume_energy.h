@@ -1,0 +1,63 @@
+// The volume term of the stable Neo-Hookean energy on nodal averages of the volume change
+// (average nodal pressure: Bonet & Burton 1998; Bonet, Marriott & Hassan 2001), so that
+// linear tetrahedra do not lock as nu -> 0.5. With the element form every tetrahedron must
+// keep its own volume: about 5 constraints per vertex against 3 degrees of freedom, and a
+// near-incompressible mesh cannot bend. Averaged over each vertex's patch there is one per
+// vertex. Together with ElasticEnergy on the materials' shear parts (shear_part()):
+//
+//   E = sum_t V_t [mu/2 (I_C - 3) - mu (J_t - 1)] + sum_n V_n lambda_n / 2 (Jbar_n - 1)^2,
+//   V_n = sum_{t at n} V_t / 4,   Jbar_n = sum_{t at n} V_t J_t / (4 V_n),
+//   lambda_n = sum_{t at n} V_t lambda_t / sum_{t at n} V_t   (lambda: the SNH volume stiffness),
+//
+// which equals the element form under any uniform deformation (patch test) and keeps its
+// small-strain limit. Jbar_n is the deformed patch volume over the rest patch volume: a
+// polynomial in x, defined for inverted elements like the element form.
+//
+// Hessian: sum_n lambda_n / V_n a_n a_n^T (a_n = dv_n/dx, PSD, couples a vertex's whole patch)
+// plus sum_t s_t d2v_t/dx2 with s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 (indefinite;
+// eigen-clamped per element when projecting). The patches are its Hessian cliques.
+#pragma once
+
+#include <vector>
+
+#include "breast_tumour_registration/fem/energy_term.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+
+namespace btr {
+
+class NodalVolumeEnergy : public EnergyTerm {
+ public:
+  /// rest    rest configuration
+  /// lambda  #T volume stiffness per tetrahedron [Pa] (StableNeoHookean::lambda(), >= 0)
+  NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda);
+
+  std::string name() const override { return "nodal volume"; }
+  double value(const Points& x) const override;
+  void add_gradient(const Points& x, Eigen::VectorXd& g) const override;
+  void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const override;
+  std::vector<std::vector<int>> hessian_cliques() const override { return patches_; }
+
+  /// Jbar_n for every vertex (1 at rest; 0 for a vertex in no tetrahedron).
+  Eigen::VectorXd nodal_volume_ratios(const Points& x) const;
+
+ private:
+  /// s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 [Pa]: the tetrahedron's share of its nodes' pressures.
+  double element_pressure(const Eigen::VectorXd& Jbar, Eigen::Index t) const;
+  /// v_t = V_t J_t of every tetrahedron at x.
+  Eigen::VectorXd element_volumes(const Points& x) const;
+  Tetrahedra T_;
+  std::vector<TetRestData> rest_;
+  Eigen::VectorXd Vn_;       // rest patch volume / 4 per vertex (V_n)
+  Eigen::VectorXd lambda_n_;
+  std::vector<std::vector<int>> patches_;    // per vertex: sorted vertices of its tetrahedra (empty: none)
+  std::vector<std::vector<int>> tets_of_;    // per vertex: its tetrahedra
+  // Scatter maps into the assembler's values, built on first use per assembler: the element
+  // blocks, and for vertex n |patch|^2 block offsets (from patch_offset_[n]) and |patch| column
+  // strides (from patch_stride_[n]); -1: a fixed vertex.
+  void build_scatter(const HessianAssembler& H) const;
+  mutable TetScatter tet_scatter_;  // its assembler id also marks the patch maps as current
+  mutable std::vector<long> patch_offsets_, patch_strides_;
+  mutable std::vector<size_t> patch_offset_, patch_stride_;
+};
+
+}  // namespace btr

@@ -1,0 +1,38 @@
+// Tetrahedralization of a closed surface with CGAL Mesh_3 (Delaunay refinement with
+// sharp-feature protection, then perturbation and exudation to remove slivers).
+// Mesh_3 remeshes the boundary, so input vertices are generally not kept: references to
+// them (landmarks, chest wall) are re-attached with surface_attachment.h.
+#pragma once
+
+#include "breast_tumour_registration/base/types.h"
+
+namespace btr {
+
+struct TetrahedralizeOptions {
+  double cell_size = 0.008;          ///< target edge / circumradius bound [m]
+  double radius_edge_ratio = 2.0;    ///< circumradius / shortest edge bound (TetGen's -q)
+  double facet_distance_ratio = 0.1; ///< surface approximation error, relative to cell_size
+  double facet_angle = 25.0;         ///< minimum boundary triangle angle [deg]
+  double feature_angle = 60.0;       ///< dihedral angle below which an edge is sharp [deg]
+  bool optimize = true;              ///< perturb and exude slivers
+};
+
+struct TetQuality {
+  double max_radius_edge = 0;     ///< worst circumradius / shortest edge
+  double median_radius_edge = 0;
+  double min_dihedral_deg = 0;    ///< smallest dihedral angle [deg]
+  double min_volume = 0;          ///< [m^3]
+};
+
+/// The largest mesh this package makes (about 3 GB through meshing and solving).
+constexpr double kMaxTetrahedra = 3e6;
+
+/// Tetrahedralizes the volume bounded by `surface` (closed, consistently oriented; call
+/// validate_surface first). Output tetrahedra are positively oriented. Throws InputError
+/// for bad options, for a cell size whose estimated mesh exceeds kMaxTetrahedra (before any
+/// meshing), or when meshing produces no tetrahedra.
+TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& opt);
+
+TetQuality tet_quality(const TetMesh& mesh);
+
+}  // namespace btr

@@ -1,0 +1,73 @@
+// Rigid refinement with PCL ICP (point-to-plane, median-distance correspondence rejection,
+// voxel-downsampled clouds; normals estimated on both, or a target with known normals
+// prepared once) behind an interface without PCL types, so that only icp_alignment.cpp
+// pays PCL's compile time. Its result is checked (convergence and inlier RMS), never
+// trusted blindly.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "breast_tumour_registration/geometry/rigid_transform.h"
+
+namespace btr {
+
+struct IcpOptions {
+  int max_iterations = 40;
+  double max_correspondence_distance = 0.01;  ///< [m] of the final (fine) pass
+  /// [m] a first pass with this wider radius captures larger initial offsets; <= 0: none.
+  double coarse_correspondence_distance = 0.05;
+  double voxel_size = 0.003;                  ///< [m] downsampling; <= 0: none
+  int normal_neighbours = 12;
+  double transformation_epsilon = 1e-10;
+  double median_factor = 3.0;       ///< reject correspondences beyond this times the median distance
+  double max_inlier_rms = 0.002;    ///< [m] accept only below this
+  double min_overlap = 0.3;         ///< accept only when this fraction of source points has a correspondence
+};
+
+struct IcpResult {
+  Rigid transform = Rigid::Identity();  ///< maps source points onto the target (includes `initial`)
+  bool converged = false;     ///< PCL's own verdict
+  bool accepted = false;      ///< converged and within the RMS and overlap bounds
+  double inlier_rms = 0;      ///< [m] RMS distance of correspondences within max distance
+  double overlap = 0;         ///< fraction of source points within max distance after alignment
+  int iterations = 0;
+  double seconds = 0;
+  std::string message;        ///< why it was (not) accepted
+};
+
+/// Aligns `source` (rows are points, e.g. the supine rigid region) to `target` (e.g. the
+/// prone chest ring), starting from `initial`. Normals of both are estimated from
+/// neighbours. Throws InputError for empty or NaN clouds.
+IcpResult align_icp(const Points& source, const Points& target, const Rigid& initial, const IcpOptions& opt);
+
+/// A fixed ICP target prepared once: points with known unit normals (e.g. samples of a
+/// model surface) and their kd-tree or nearest-sample grid, so that aligning a stream of
+/// clouds to it costs only the source's downsampling and the iterations.
+class IcpTarget {
+ public:
+  /// With lookup_cell > 0, correspondences are found in constant time by a
+  /// NearestSampleGrid of that cell size covering lookup_radius around the points (which
+  /// must be at least the max_correspondence_distance of later alignments); otherwise by
+  /// the kd-tree. Throws InputError when there are fewer than 6 points, the sizes differ,
+  /// a value is not finite or a normal is not of unit length.
+  IcpTarget(const Points& points, const Points& normals, double lookup_cell = 0, double lookup_radius = 0);
+  ~IcpTarget();
+  IcpTarget(IcpTarget&&) noexcept;
+  IcpTarget& operator=(IcpTarget&&) noexcept;
+  Eigen::Index size() const;
+  /// The correspondence radius the grid covers [m]; 0 without a grid.
+  double lookup_radius() const;
+
+ private:
+  friend IcpResult align_icp(const Points&, const IcpTarget&, const Rigid&, const IcpOptions&);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Aligns `source` (voxel-downsampled by opt.voxel_size; no normals needed) to a prepared
+/// target by point-to-plane ICP with the target's normals. Only the fine pass
+/// (max_correspondence_distance) runs. Throws InputError for an empty or NaN source.
+IcpResult align_icp(const Points& source, const IcpTarget& target, const Rigid& initial, const IcpOptions& opt);
+
+}  // namespace btr

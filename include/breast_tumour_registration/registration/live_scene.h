@@ -1,0 +1,34 @@
+// A live registration's scene: the prepared scene with its supine side replaced by the
+// latest depth scan. What the ROS node's ~register service does with use_latest_cloud, as
+// a core function (tested without ROS).
+#pragma once
+
+#include "breast_tumour_registration/geometry/rigid_transform.h"
+#include "breast_tumour_registration/io/scene.h"
+
+namespace btr {
+
+struct LiveScan {
+  Points cloud;           ///< working frame [m]; organized (width * height rows, NaN = no data) or not (width 0)
+  int width = 0, height = 0;
+  Rigid supine_to_working = Rigid::Identity();  ///< the tracked alignment of the scene's supine frame
+};
+
+struct LiveSceneOptions {
+  double max_depth_edge = 0.01;  ///< [m] no triangle across a longer edge (depth discontinuities)
+  bool use_landmarks = true;     ///< keep the scene's supine landmarks (moved into the working frame)
+};
+
+struct LiveScene {
+  Scene scene;                  ///< supine side in the working frame; automatic steps
+  Rigid known_supine_to_model;  ///< for RegistrationOptions::known_supine_to_model: the tracked pose decides
+};
+
+/// The scene to register against the scan: an organized cloud is triangulated (the surface
+/// step projects onto it), an unorganized one is used as points (PCA normals); the scene's
+/// supine landmarks (or none, without use_landmarks) and tumour ground truth are moved into
+/// the working frame by the tracked alignment, and the steps are planned automatically from
+/// what remains. InputError for a cloud that gives no surface or no finite point.
+LiveScene live_scene(const Scene& prepared, const LiveScan& scan, const LiveSceneOptions& opt = {});
+
+}  // namespace btr

@@ -1,0 +1,137 @@
+// The scene-driven registration pipeline: it runs only the steps the scene's inputs call for
+// (rigid alignment, optional gravity pre-step, landmark-guided, surface-guided) and reports
+// the tumours in the supine frame with the figures of merit.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/io/scene.h"
+#include "breast_tumour_registration/registration/icp_alignment.h"
+#include "breast_tumour_registration/registration/landmark_step.h"
+#include "breast_tumour_registration/registration/rigid_regions.h"
+#include "breast_tumour_registration/registration/stiffness_step.h"
+#include "breast_tumour_registration/registration/surface_step.h"
+#include "breast_tumour_registration/registration/unload_step.h"
+
+namespace btr {
+
+struct RegistrationOptions {
+  std::string preset = "balanced";
+  IcpOptions icp;
+  RigidRegionOptions rigid_regions;  ///< symmetry checks of the rigid regions (its icp field is replaced by `icp`)
+  LandmarkStepOptions landmark;
+  SurfaceStepOptions surface;
+  NewtonOptions gravity;  ///< gravity pre-step
+  StiffnessOptions stiffness;  ///< stiffness step (its range is the scene's)
+  /// > 0: simulate on the prone model re-tetrahedralized at this cell size [m] when the
+  /// scene's mesh is finer (see simulation_scene); 0: the scene's mesh as given.
+  double simulation_cell_size = 0;
+  /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
+  /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
+  std::optional<Rigid> known_supine_to_model;
+  /// [m] When ICP on the rigid regions decides the pose and the pose solved jointly with the
+  /// landmarks moves the rigid region by more than this, the result carries a warning.
+  double pose_disagreement_warning = 0.003;
+  /// Plausibility of the result (a result far from its own data is not an answer, whatever
+  /// the solver's verdict): it is flagged `implausible`, with a warning, when the largest
+  /// landmark residual (when the landmark step ran) exceeds max(landmark_residual_bound, landmark_residual_fraction x the
+  /// prone model's bounding-box diagonal), or the mean distance of the skin to the supine
+  /// surface exceeds max(skin_distance_bound, skin_distance_fraction x that diagonal).
+  /// Chosen on two bodies (BENCHMARKS.md): far above what converged runs show, below a
+  /// model that cannot follow its data (locked, far too stiff) or a flipped pose.
+  double landmark_residual_bound = 0.005;      ///< [m]
+  double landmark_residual_fraction = 0.02;
+  double skin_distance_bound = 0.002;          ///< [m]
+  double skin_distance_fraction = 0.01;
+};
+
+/// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
+/// measured speed and accuracy of each). Throws InputError for another name.
+RegistrationOptions preset_options(const std::string& name);
+
+struct PlannedSteps {
+  bool rigid_landmarks = false;  ///< Kabsch on >= 3 landmark pairs (first guess; the landmark step then solves the pose)
+  bool rigid_icp = false;        ///< ICP on prone and supine rigid regions
+  bool stiffness = false;        ///< Young's modulus estimated from the data (youngs_modulus: estimate), before unload
+  bool unload = false;           ///< the rest shape is the unloaded shape estimated from the prone one (scene.prone_gravity)
+  bool gravity = false;
+  bool landmarks = false;
+  bool surface = false;
+  std::string describe() const;
+};
+
+/// Steps for the scene: `auto` (scene.steps empty) takes every step its inputs allow
+/// (rigid when it has >= 3 landmarks or both rigid regions; landmarks; surface). An
+/// explicit list is checked against the inputs; a missing input is an InputError naming
+/// the field. `unload` is planned exactly when the scene gives prone_gravity, listed or not:
+/// it changes the model every other step simulates, not the data they fit. `stiffness` is
+/// planned exactly when the scene says `youngs_modulus: estimate`, and needs prone_gravity and
+/// >= 3 landmarks.
+PlannedSteps plan_steps(const Scene& scene);
+
+/// When opt.simulation_cell_size asks for a clearly coarser mesh than the scene's (mean edge
+/// below 1.1 cell sizes; a mesh made at that size has about 1.35): the scene with its prone model re-tetrahedralized
+/// (with_simulation_mesh); otherwise nullopt (simulate on the scene's mesh). Callers
+/// prepare it once and cache it with its model.
+std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt);
+
+/// Builds the registration model of a scene (material, tumours embedded, stiffer tumour if
+/// asked, and the unloaded rest shape when the scene gives prone_gravity: model.unload, whose
+/// report every run_registration result carries; with `youngs_modulus: estimate` the unload
+/// waits for the stiffness, and runs in run_registration). `warnings` receives messages about tumour
+/// points outside the mesh.
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload = {});
+
+struct TumourResult {
+  std::string name;
+  SurfaceMesh registered;   ///< supine frame
+  Vec3 centroid;            ///< supine frame [m]
+  double volume_ratio = 0;  ///< registered volume / prone volume
+  double axis_ratio = 0;    ///< shortest / longest principal axis of the registered tumour
+  double prone_axis_ratio = 0;  ///< the same for the prone tumour (flattening: axis_ratio < prone_axis_ratio)
+  bool has_ground_truth = false;
+  double centroid_distance = 0;  ///< [m] to the ground-truth centroid
+  double hausdorff = 0;          ///< [m]
+  double volume_ratio_to_truth = 0;
+  double truth_axis_ratio = 0;
+  double rigid_centroid_distance = 0;  ///< [m] prone tumour (rigidly aligned) to ground truth
+};
+
+struct RegistrationResult {
+  PlannedSteps steps;
+  Rigid supine_to_model = Rigid::Identity();  ///< the rigid alignment found
+  bool icp_used = false;
+  IcpResult icp;
+  bool pose_solved_with_landmarks = false;  ///< the landmark step solved the pose (no decisive ICP)
+  bool pose_solved_with_surface = false;    ///< the surface step refined it (no decisive ICP)
+  int rigid_distinct_poses = 0;       ///< distinct poses the rigid regions fit equally well (> 1: symmetric)
+  bool rigid_decided_by_landmarks = false;  ///< several of them, and the landmarks chose
+  bool rigid_pose_undecided = false;  ///< several of them and nothing told them apart (a warning says so)
+  std::string rigid_note;             ///< what the symmetry check found (empty: one pose fits)
+  double pose_disagreement = 0;  ///< [m] ICP vs joint landmark pose, max over the rigid region (when both ran)
+  double rigid_seconds = 0;
+  /// [Pa] the stiffness step's estimate (0: not estimated); the steps simulated with every
+  /// material scaled to it
+  double estimated_youngs_modulus = 0;
+  std::vector<std::pair<double, double>> stiffness_evaluations;  ///< (E [Pa], landmark misfit [m]) it tried
+  std::vector<StepReport> reports;
+  Points x;                 ///< deformed vertex positions, model frame
+  double seconds = 0;       ///< all steps, rigid alignment included
+  std::vector<TumourResult> tumours;
+  double landmark_residual_mean = 0, landmark_residual_max = 0;  ///< [m]
+  double skin_distance_mean = 0, skin_distance_max = 0;          ///< [m] to the supine surface
+  bool converged = true;
+  /// The result is far from its own data (see RegistrationOptions' plausibility bounds) or
+  /// the rigid pose was left undecided; `warnings` says which. btr_register exits with 5.
+  bool implausible = false;
+  std::vector<std::string> warnings;
+};
+
+/// Runs the planned steps. Throws InputError for inconsistent inputs and SolverError for
+/// numerical failure; a step that stops without converging sets `converged = false`.
+RegistrationResult run_registration(const Scene& scene, const RegistrationModel& prepared, const RegistrationOptions& opt,
+                                    const StepCallback& callback = {});
+
+}  // namespace btr

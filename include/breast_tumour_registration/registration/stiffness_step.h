@@ -1,0 +1,61 @@
+// The stiffness step: the tissue's Young's modulus estimated from the data, for scenes that
+// say `material: {youngs_modulus: estimate}`. The unloaded shape depends on the stiffness as
+// much as on the geometry (a breast of 200 Pa sags ten times as far as one of 2 kPa): with an
+// assumed E far from the patient's, the unloaded shape is wrong by about the difference of
+// the sags and no later step can undo it.
+//
+// For a candidate E (every material scaled by the same factor, so a heterogeneous model keeps
+// its ratios) the model is unloaded from the prone shape under the prone gravity, then loaded
+// under the supine gravity; the objective is the RMS misfit of the landmarks so predicted to
+// the supine landmarks after their best rigid fit (Kabsch), so it does not depend on the pose.
+// The search is a log-spaced grid from the stiff end, stopped once the misfit has clearly
+// passed its minimum (the soft candidates are the costly ones), then parabolic refinement in
+// log E around the best point. Equilibrium is invariant under scaling E and gravity together,
+// so a candidate is simulated with the gravities divided by the factor.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "breast_tumour_registration/fem/energy_term.h"
+#include "breast_tumour_registration/fem/unloaded_shape.h"
+#include "breast_tumour_registration/geometry/anchor.h"
+#include "breast_tumour_registration/registration/registration_model.h"
+
+namespace btr {
+
+struct StiffnessOptions {
+  double min_youngs_modulus = 150;    ///< [Pa] of the model's first material
+  double max_youngs_modulus = 24000;  ///< [Pa]
+  int grid_points = 8;                ///< log-spaced over the range
+  double relative_tolerance = 0.05;   ///< refinement stops when a step changes E by less than this
+  int max_refinements = 6;
+  UnloadOptions unload;               ///< of every candidate's unload
+};
+
+struct StiffnessEstimate {
+  double scale = 1;           ///< E / the model's E (every material)
+  double youngs_modulus = 0;  ///< [Pa] the estimate for the model's first material
+  double misfit = 0;          ///< [m] RMS landmark misfit of the gravity-only prediction at the estimate
+  bool converged = false;     ///< the refinement met relative_tolerance inside the range
+  bool at_bound = false;      ///< the best candidate is an end of the range (the estimate is a bound)
+  std::string stop_reason;
+  std::vector<std::pair<double, double>> evaluations;  ///< (E [Pa], misfit [m]), in the order evaluated (inf: failed)
+  Points rest;                ///< the unloaded shape at the estimate
+  UnloadResult unload;        ///< its unload
+  double seconds = 0;
+};
+
+/// Estimates the stiffness of `model` (its prone shape model.prone; its materials as the
+/// reference) from the supine landmark positions `supine` (any frame, one row per anchor).
+/// Throws InputError for fewer than 3 landmarks or a bad range; a range in which no candidate
+/// could be simulated is a SolverError.
+StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3& prone_gravity,
+                                     const std::vector<Anchor>& anchors, const Points& supine,
+                                     const StiffnessOptions& options = {});
+
+/// The model with every material scaled by `scale` (material.youngs_modulus too).
+void scale_stiffness(RegistrationModel& model, double scale);
+
+}  // namespace btr

@@ -1,0 +1,57 @@
+// Surface-guided deformation (thesis Sec. 4.4, Algorithm 2): the prone skin vertices (not
+// the chest wall, not the interior) are projected onto the supine surface (CGAL AABB tree);
+// soft point (eq. 4.2) and point-to-plane (eq. 4.3) springs hold them there while the
+// interior follows; the chest wall is fixed by eliminating its DOFs, so every system is
+// symmetric positive definite (the thesis solves a KKT system with LU instead). Projection
+// and Newton alternate until the projections stop moving.
+#pragma once
+
+#include "breast_tumour_registration/geometry/anchor.h"
+#include "breast_tumour_registration/geometry/rigid_transform.h"
+#include "breast_tumour_registration/geometry/surface_projector.h"
+#include "breast_tumour_registration/registration/registration_model.h"
+
+namespace btr {
+
+struct SurfaceStepOptions {
+  double point_weight = 30;      ///< [N/m] per skin vertex: allows tangential sliding
+  double plane_weight = 3000;    ///< [N/m] per skin vertex: holds the skin on the surface
+  bool gravity = true;
+  /// Safety cap on the outer iterations (projection + Newton); reaching it is reported as
+  /// not converged, with the last change of the projections.
+  int max_projections = 40;
+  int newton_per_projection = 1; ///< Newton iterations between projections (thesis: 1)
+  /// [m] Convergence: the held skin moved less than this (RMS) since the previous projection,
+  /// then Newton on the settled projections meets its gradient criterion (up to
+  /// newton.max_iterations). The skin's motion, not the projections' change: on a noisy scan
+  /// the projections jitter along the surface while the skin stays put.
+  double projection_tolerance = 2e-5;
+  /// A stall: the skin's motion between projections has not reached a new low for this many
+  /// projections (reported as not converged).
+  int stall_projections = 8;
+  /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
+  double max_projection_distance = 0.03;
+  /// With a free pose: the weight [N/m] of the point springs (landmarks) that share the pose.
+  double pose_points_weight = 1e4;
+  /// Projections onto the border of an open supine surface (the edge of a depth scan, the
+  /// rim of a hole behind an occlusion) are dropped: that skin is not in the scan.
+  bool reject_boundary = true;
+  NewtonOptions newton;
+};
+
+/// supine: projection onto the supine surface in the model frame (a mesh, closed or open,
+/// or a point cloud). x: current positions, updated in place.
+/// pose == nullptr: the surface stays where it is. Otherwise it may move rigidly and its pose
+/// is solved jointly with the deformation (RigidFreeSurfaceEnergy); on return *pose maps the
+/// model frame into the frame the projector was given in.
+/// pose_points (with a free pose only): point correspondences such as the landmarks, targets
+/// in the projector's frame, that share the pose (opt.pose_points_weight).
+struct PosePoints {
+  std::vector<Anchor> anchors;
+  Points targets;
+};
+StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
+                        Points& x, const StepCallback& callback = {}, Rigid* pose = nullptr,
+                        const PosePoints* pose_points = nullptr);
+
+}  // namespace btr

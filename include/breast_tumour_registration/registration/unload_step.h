@@ -1,0 +1,35 @@
+// The unload step: when the gravity the prone image was taken under is known, the model's rest
+// shape becomes the estimated unloaded shape (unloaded_shape.h) instead of the prone shape, and
+// every later step simulates from it with the supine gravity, starting from the prone positions.
+// It depends on the model only (mesh, chest wall, materials), so it runs once per prepared model.
+#pragma once
+
+#include "breast_tumour_registration/fem/unloaded_shape.h"
+#include "breast_tumour_registration/registration/registration_model.h"
+
+namespace btr {
+
+/// Estimates the unloaded shape of `model` (from model.prone, under prone_gravity in the model
+/// frame [m/s^2]) and makes it the rest shape; model.unload receives the report.
+///
+/// A converged estimate is used. One that stopped (a cap, divergence, a failed solve) is used
+/// only when re-simulating from it reproduces the prone shape better than the prone shape as
+/// rest would (its mismatch is below the prone sag the inverse-gravity solve measured);
+/// otherwise the prone shape stays the rest shape. Either way the report says not converged,
+/// and its note says which shape was kept.
+StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options = {});
+
+/// The unload problem of `model`'s mesh, chest wall and materials for the imaged shape `loaded`
+/// (its vertices: model.prone, kept alive by the caller) under `gravity` [m/s^2].
+UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity);
+
+/// The step report of an unload (name "unload"; mismatch, cost, and how far the rest shape
+/// moved from `prone`).
+StepReport unload_report(const UnloadResult& unload, const Points& prone);
+
+/// Makes `rest` (an unloaded shape found before, e.g. cached) the rest shape of `model`,
+/// recording `report` as its unload step. Throws InputError when the size does not match or an
+/// element of it is inverted.
+void set_rest_shape(RegistrationModel& model, const Points& rest, const StepReport& report);
+
+}  // namespace btr

@@ -1,0 +1,83 @@
+#include "breast_tumour_registration/fem/forward_gravity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/gravity_energy.h"
+
+namespace btr {
+
+ForwardGravity::ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const std::vector<int>& fixed,
+                               std::vector<StableNeoHookean> materials, std::vector<int> material_of,
+                               VolumeForm volume_form, double density, ForwardGravityOptions options)
+    : rest_{Points::Zero(vertices, 3), T},
+      fixed_(static_cast<size_t>(vertices), false),
+      materials_(std::move(materials)),
+      material_of_(std::move(material_of)),
+      volume_form_(volume_form),
+      density_(density),
+      opt_(std::move(options)) {
+  if (volume_form_ == VolumeForm::Auto) throw InputError("forward gravity: resolve the volume form first");
+  if (!(opt_.first_load_fraction > 0 && opt_.first_load_fraction <= 1) || !(opt_.min_load_fraction > 0))
+    throw InputError("forward gravity: load fractions must lie in (0, 1]");
+  for (int v : fixed) {
+    if (v < 0 || v >= vertices) throw InputError("forward gravity: fixed vertex " + std::to_string(v) + " out of range");
+    fixed_[static_cast<size_t>(v)] = true;
+  }
+}
+
+NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Points& x) {
+  rest_.V = X;
+  TotalEnergy energy;
+  add_elastic_energy(energy, rest_, materials_, material_of_, volume_form_);
+  auto g = std::make_shared<GravityEnergy>(rest_, density_, gravity);
+  energy.add(g);
+  if (!assembler_) {  // the pattern does not depend on the rest positions
+    assembler_ = std::make_shared<HessianAssembler>(static_cast<int>(X.rows()), rest_.T, fixed_, energy.hessian_cliques());
+    solver_ = std::make_unique<NewtonSolver>(assembler_, rest_.T);
+  }
+  NewtonOptions nopt = opt_.newton;
+  if (nopt.force_scale <= 0) nopt.force_scale = g->total_weight();
+  for (Eigen::Index v = 0; v < X.rows(); ++v)
+    if (fixed_[static_cast<size_t>(v)]) x.row(v) = X.row(v);
+  const NewtonResult nr = solver_->solve(energy, x, nopt);
+  newton_iterations_ += nr.iterations;
+  return nr;
+}
+
+int ForwardGravity::solve(const Points& X, const Vec3& gravity, Points& x) {
+  if (X.rows() != static_cast<Eigen::Index>(fixed_.size()) || x.rows() != X.rows())
+    throw InputError("forward gravity: " + std::to_string(X.rows()) + " rest and " + std::to_string(x.rows()) +
+                     " start positions for a mesh of " + std::to_string(fixed_.size()) + " vertices");
+  const Points start = x;
+  NewtonResult nr = solve_once(X, gravity, x);
+  if (nr.converged) return nr.iterations;
+  int n = nr.iterations;
+  x = X;  // continuation from the unloaded state
+  double s = 0, ds = opt_.first_load_fraction;
+  while (s < 1) {
+    const double next = std::min(1.0, s + ds);
+    Points xs = x;
+    nr = solve_once(X, next * gravity, xs);
+    n += nr.iterations;
+    if (nr.converged) {
+      x = xs;
+      s = next;
+      ++load_steps_;
+      ds *= 1.5;
+    } else {
+      ds *= 0.5;
+      if (ds < opt_.min_load_fraction) {
+        x = start;
+        throw SolverError("forward gravity solve stopped without converging at " +
+                          std::to_string(static_cast<int>(std::lround(next * 100))) + " % of the load (" +
+                          to_string(nr.reason) + ")");
+      }
+    }
+  }
+  return n;
+}
+
+}  // namespace btr

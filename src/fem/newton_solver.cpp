@@ -1,0 +1,300 @@
+#include "breast_tumour_registration/fem/newton_solver.h"
+
+#include <Eigen/CholmodSupport>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/line_search.h"
+#include "breast_tumour_registration/fem/pcg.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+
+namespace btr {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+std::string to_string(StopReason r) {
+  switch (r) {
+    case StopReason::GradientTolerance: return "gradient tolerance reached";
+    case StopReason::StepTolerance: return "full Newton step below the step tolerance";
+    case StopReason::Stalled: return "stalled: line-search steps below the step tolerance with the gradient above its tolerance";
+    case StopReason::InvertedAfterStall:
+      return "stalled: every step inverted an element, and letting them invert folded the mesh; the last uninverted "
+             "state is kept";
+    case StopReason::MaxIterations: return "maximum iterations reached";
+    case StopReason::LineSearchFailed: return "line search found no decrease";
+    case StopReason::Aborted: return "aborted by callback";
+  }
+  return "unknown";
+}
+
+StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
+                              const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
+                              long& n_inv, IterationInfo& info, NewtonResult& res) {
+  const double full_step = dx.rowwise().norm().maxCoeff();
+  if (full_step <= opt.step_tolerance) return StepOutcome::TooSmall;
+  const auto t0 = Clock::now();
+  const LineSearchResult ls = backtracking_line_search(energy, x, dx, E, slope, n_inv, tets, line_search_options(opt), x_trial);
+  info.t_line_search = since(t0);
+  res.t_assembly += info.t_assembly;
+  res.t_factorization += info.t_factorization;
+  res.t_solve += info.t_solve;
+  res.t_line_search += info.t_line_search;
+  if (!ls.accepted) return StepOutcome::NoDecrease;
+  x.swap(x_trial);
+  E = ls.energy;
+  n_inv = ls.inverted;
+  info.energy = E;
+  info.alpha = ls.alpha;
+  info.step_norm = ls.alpha * full_step;
+  info.inverted = n_inv;
+  return StepOutcome::Taken;
+}
+
+bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res) {
+  res.iterations = info.iteration;
+  res.energy = info.energy;
+  res.gradient_norm = info.gradient_norm;
+  res.inverted = info.inverted;
+  res.history.push_back(info);
+  if (opt.callback && !opt.callback(info)) {
+    res.reason = StopReason::Aborted;
+    return true;
+  }
+  if (info.gradient_norm <= gradient_tolerance) {
+    res.reason = StopReason::GradientTolerance;
+    res.converged = true;
+    return true;
+  }
+  return false;
+}
+
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res) {
+  if (direction_was_lagged) return true;  // first: a fresh factorization
+  if (outcome != StepOutcome::TooSmall && opt.forbid_new_inversions) {
+    // Second: let the line search invert elements. The stable Neo-Hookean energy is defined
+    // there, and soft tissue pulled by stiff springs otherwise freezes on one nearly flat
+    // element (measured: E = 400 Pa, surface step stalled at 590 N, tumour 13.8 mm off;
+    // with inversions allowed it converges, 0.77 mm). The result reports the inverted count.
+    opt.forbid_new_inversions = false;
+    res.inversions_allowed = true;
+    return true;
+  }
+  switch (outcome) {
+    case StepOutcome::TooSmall:  // the exact Newton step: the minimum is within step_tolerance
+      res.reason = StopReason::StepTolerance;
+      res.converged = true;
+      break;
+    case StepOutcome::NoDecrease:
+      res.reason = StopReason::LineSearchFailed;
+      res.converged = false;
+      break;
+    default:  // a damped step too short to make progress
+      res.reason = StopReason::Stalled;
+      res.converged = false;
+  }
+  return false;
+}
+
+void InversionGuard::arm(const NewtonResult& res, const Points& x_now, double E, long n_inv) {
+  if (armed || !res.inversions_allowed) return;
+  armed = true;
+  x = x_now;
+  energy = E;
+  inverted = n_inv;
+}
+
+bool InversionGuard::restore_if_worse(Points& x_now, double& E, long& n_inv, NewtonResult& res, long n_tets,
+                                      double max_fraction) const {
+  if (!armed || static_cast<double>(n_inv - inverted) <= max_fraction * static_cast<double>(n_tets)) return false;
+  x_now = x;
+  E = energy;
+  n_inv = inverted;
+  res.reason = StopReason::InvertedAfterStall;
+  res.converged = false;
+  return true;
+}
+
+LineSearchOptions line_search_options(const NewtonOptions& opt) {
+  LineSearchOptions l;
+  l.max_steps = opt.max_line_search_steps;
+  l.armijo = opt.armijo;
+  l.forbid_new_inversions = opt.forbid_new_inversions;
+  return l;
+}
+
+struct NewtonSolver::Impl {
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  bool analyzed = false;
+  bool have_factor = false;  // llt holds a factor of some earlier Hessian (same pattern)
+
+};
+
+NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
+    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {
+  // A failed factorization is expected (the unprojected Hessian tried near the solution) and
+  // handled here; CHOLMOD's own "not positive definite" lines on stderr would only alarm.
+  impl_->llt.cholmod().print = 0;
+}
+
+NewtonSolver::~NewtonSolver() = default;
+
+NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
+  const auto t_start = Clock::now();
+  HessianAssembler& H = *assembler_;
+  NewtonResult res;
+  auto inverted = [&](const Points& p) { return tets_.rows() ? count_inverted(p, tets_) : 0L; };
+
+  double E = energy.value(x);
+  if (!std::isfinite(E)) throw SolverError("energy is not finite at the initial state (NaN or Inf positions?)");
+  Eigen::VectorXd g = H.gather(energy.gradient(x));
+  long n_inv = inverted(x);
+  res.initial_energy = res.energy = E;
+  res.initial_gradient_norm = res.gradient_norm = g.norm();
+  res.inverted = n_inv;
+  const double g_tol = opt.gradient_abs_tolerance +
+                       opt.gradient_rel_tolerance * std::max(res.initial_gradient_norm, opt.force_scale);
+  if (H.num_free_dofs() == 0 || res.gradient_norm <= opt.gradient_abs_tolerance ||
+      (opt.force_scale > 0 && res.gradient_norm <= g_tol)) {
+    res.reason = StopReason::GradientTolerance;
+    res.converged = true;
+    res.seconds = since(t_start);
+    return res;
+  }
+
+  Points x_trial(x.rows(), 3);
+  NewtonOptions local = opt;  // a stall may relax the inversion rule for the rest of the solve
+  InversionGuard guard;
+  bool fresh_factor = false;  // the last direction stalled on the lagged factor: refactorize
+  // Near the solution the unprojected Hessian (positive definite there as a whole, although
+  // compressed elements are indefinite on their own) restores quadratic convergence; the
+  // projected one converges linearly in that tail. Any sign of trouble switches back.
+  bool exact = false;
+  double exact_retry_below = std::numeric_limits<double>::infinity();  // after a failed try: wait for progress
+  auto leave_exact = [&] {
+    exact = false;
+    exact_retry_below = 0.5 * g.norm();
+  };
+  for (int it = 1; it <= opt.max_iterations; ++it) {
+    IterationInfo info;
+    info.iteration = it;
+
+    auto t0 = Clock::now();
+    energy.hessian(x, opt.project_psd && !exact, H);
+    const LowRankHessian low = energy.low_rank_hessian(x, H);  // H - W M W^T (usually empty)
+    info.t_assembly = since(t0);
+
+    auto& llt = impl_->llt;
+    Eigen::VectorXd d;
+    bool solved = false;
+    if (opt.reuse_factorization && impl_->have_factor && !fresh_factor) {
+      t0 = Clock::now();
+      const double eta = std::min(opt.max_forcing, std::sqrt(g.norm() / std::max(res.initial_gradient_norm, 1e-300)));
+      const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
+      auto apply = [&](const Eigen::VectorXd& v) {
+        Eigen::VectorXd out = Hs * v;
+        if (low.W.cols()) out.noalias() -= low.W * (low.M * (low.W.transpose() * v));
+        return out;
+      };
+      solved = preconditioned_cg(apply,
+                                 [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(impl_->llt.solve(v)); }, -g, eta,
+                                 opt.max_pcg_iterations, d, info.pcg_iterations);
+      info.t_solve = since(t0);
+      res.pcg_iterations += info.pcg_iterations;
+    }
+    if (!solved) {
+      t0 = Clock::now();
+      if (!impl_->analyzed) {
+        llt.analyzePattern(H.matrix());
+        impl_->analyzed = true;
+      }
+      // The projected Hessian is PSD; with few constraints it can be singular, so a
+      // growing diagonal shift is tried before giving up.
+      double shift = 0;
+      const double diag_scale = H.matrix().diagonal().cwiseAbs().maxCoeff();
+      llt.setShift(0);
+      llt.factorize(H.matrix());
+      if (llt.info() != Eigen::Success && exact) {  // not positive definite after all: project again
+        leave_exact();
+        energy.hessian(x, true, H);
+        llt.factorize(H.matrix());
+      }
+      while (llt.info() != Eigen::Success) {
+        shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
+        if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30)) {
+          impl_->have_factor = false;
+          throw SolverError("Hessian could not be factorized even with a diagonal shift (non-finite entries?)");
+        }
+        llt.setShift(shift);
+        llt.factorize(H.matrix());
+        ++res.regularizations;
+      }
+      impl_->have_factor = true;
+      ++res.factorizations;
+      info.factorized = true;
+      info.t_factorization = since(t0);
+      t0 = Clock::now();
+      d = -llt.solve(g);
+      if (low.W.cols()) {
+        // Woodbury: (H - W M W^T)^-1 = H^-1 + Z (I - M W^T Z)^-1 M Z^T with Z = H^-1 W.
+        const Eigen::MatrixXd Z = llt.solve(low.W);
+        const Eigen::MatrixXd K = Eigen::MatrixXd::Identity(low.M.rows(), low.M.rows()) - low.M * (low.W.transpose() * Z);
+        d += Z * K.fullPivLu().solve(low.M * (Z.transpose() * -g));
+      }
+      info.t_solve += since(t0);
+    }
+    if (!d.allFinite()) throw SolverError("Newton direction is not finite");
+
+    // Full step as vertex displacements.
+    Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
+    H.scatter_add(d, 1.0, dx_full);
+    const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
+    const StepOutcome outcome = apply_newton_step(energy, tets_, local, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
+    if (outcome != StepOutcome::Taken) {
+      if (exact) {  // retry on the projected Hessian before calling it a stall
+        leave_exact();
+        fresh_factor = true;
+        continue;
+      }
+      if (!recover_from_stall(outcome, !info.factorized, local, res)) break;
+      guard.arm(res, x, E, n_inv);
+      fresh_factor = true;
+      continue;
+    }
+    fresh_factor = false;
+    const double g_before = g.norm();
+    g = H.gather(energy.gradient(x));
+    // Near the solution (full step accepted, |g| below 1% of the load) or where the projected
+    // Hessian only converges linearly (|g| not halved by a full step).
+    if (opt.project_psd && opt.exact_hessian_near_solution && !exact && info.alpha == 1.0 && g.norm() < exact_retry_below &&
+        (g.norm() <= 1e-2 * std::max(res.initial_gradient_norm, opt.force_scale) || g.norm() > 0.5 * g_before))
+      exact = true;
+    info.gradient_norm = g.norm();
+    info.elapsed = since(t_start);
+    if (record_iteration(info, opt, g_tol, res)) break;
+    if (info.step_norm <= opt.step_tolerance) {  // accepted, but too short to make progress
+      if (exact) {
+        leave_exact();
+        fresh_factor = true;
+        continue;
+      }
+      if (!recover_from_stall(StepOutcome::Stalled, !info.factorized, local, res)) break;
+      guard.arm(res, x, E, n_inv);
+      fresh_factor = true;
+    }
+  }
+  if (guard.restore_if_worse(x, E, n_inv, res, tets_.rows(), opt.max_inverted_fraction_after_stall))
+    g = H.gather(energy.gradient(x));
+  res.energy = E;
+  res.gradient_norm = g.norm();
+  res.inverted = n_inv;
+  res.seconds = since(t_start);
+  return res;
+}
+
+}  // namespace btr

@@ -1,0 +1,146 @@
+#include "breast_tumour_registration/fem/nodal_volume_energy.h"
+
+#include <algorithm>
+#include <string>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/hessian_pattern.h"
+#include "breast_tumour_registration/fem/small_matrices.h"
+
+namespace btr {
+
+NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda)
+    : T_(rest.T), rest_(compute_rest_data(rest)) {
+  if (static_cast<Eigen::Index>(lambda.size()) != T_.rows())
+    throw InputError("NodalVolumeEnergy: " + std::to_string(lambda.size()) + " volume stiffnesses for " +
+                     std::to_string(T_.rows()) + " tetrahedra");
+  const Eigen::Index nv = rest.V.rows();
+  Vn_ = Eigen::VectorXd::Zero(nv);
+  lambda_n_ = Eigen::VectorXd::Zero(nv);
+  patches_.assign(nv, {});
+  tets_of_.assign(nv, {});
+  for (Eigen::Index t = 0; t < T_.rows(); ++t) {
+    if (!(lambda[t] >= 0) || !std::isfinite(lambda[t]))
+      throw InputError("NodalVolumeEnergy: volume stiffness of tetrahedron " + std::to_string(t) + " is not >= 0");
+    for (int a = 0; a < 4; ++a) {
+      const int n = T_(t, a);
+      Vn_[n] += rest_[t].volume / 4;
+      lambda_n_[n] += rest_[t].volume / 4 * lambda[t];
+      tets_of_[n].push_back(static_cast<int>(t));
+      for (int b = 0; b < 4; ++b) patches_[n].push_back(T_(t, b));
+    }
+  }
+  for (Eigen::Index n = 0; n < nv; ++n) {
+    if (Vn_[n] > 0) lambda_n_[n] /= Vn_[n];
+    auto& p = patches_[n];
+    std::sort(p.begin(), p.end());
+    p.erase(std::unique(p.begin(), p.end()), p.end());
+  }
+}
+
+Eigen::VectorXd NodalVolumeEnergy::element_volumes(const Points& x) const {
+  Eigen::VectorXd v(T_.rows());
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index t = 0; t < T_.rows(); ++t)
+    v[t] = rest_[t].volume * deformation_gradient(x, T_.row(t), rest_[t].Dm_inv).determinant();
+  return v;
+}
+
+Eigen::VectorXd NodalVolumeEnergy::nodal_volume_ratios(const Points& x) const {
+  const Eigen::VectorXd v = element_volumes(x);
+  Eigen::VectorXd J = Eigen::VectorXd::Zero(Vn_.size());
+  for (Eigen::Index t = 0; t < T_.rows(); ++t)
+    for (int a = 0; a < 4; ++a) J[T_(t, a)] += v[t] / 4;
+  for (Eigen::Index n = 0; n < J.size(); ++n) J[n] = Vn_[n] > 0 ? J[n] / Vn_[n] : 0.0;
+  return J;
+}
+
+double NodalVolumeEnergy::element_pressure(const Eigen::VectorXd& J, Eigen::Index t) const {
+  double s = 0;
+  for (int a = 0; a < 4; ++a) s += lambda_n_[T_(t, a)] * (J[T_(t, a)] - 1) / 4;
+  return s;
+}
+
+double NodalVolumeEnergy::value(const Points& x) const {
+  const Eigen::VectorXd J = nodal_volume_ratios(x);
+  double e = 0;
+  for (Eigen::Index n = 0; n < J.size(); ++n)
+    if (Vn_[n] > 0) e += 0.5 * lambda_n_[n] * Vn_[n] * (J[n] - 1) * (J[n] - 1);
+  return e;
+}
+
+void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const {
+  // dE/dx = sum_t s_t dv_t/dx, s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4.
+  const Eigen::VectorXd J = nodal_volume_ratios(x);
+  for (Eigen::Index t = 0; t < T_.rows(); ++t) {
+    const double s = element_pressure(J, t);
+    const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
+    const Vec9 dJ = determinant_gradient(F);
+    const Vec12 gt = tet_gradient_from_stress(s * Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
+    for (int a = 0; a < 4; ++a) g.segment<3>(3 * T_(t, a)) += gt.segment<3>(3 * a);
+  }
+}
+
+void NodalVolumeEnergy::build_scatter(const HessianAssembler& H) const {
+  tet_scatter_.build(H, T_);
+  patch_offset_.assign(patches_.size() + 1, 0);
+  patch_stride_.assign(patches_.size() + 1, 0);
+  for (size_t n = 0; n < patches_.size(); ++n) {
+    patch_offset_[n + 1] = patch_offset_[n] + patches_[n].size() * patches_[n].size();
+    patch_stride_[n + 1] = patch_stride_[n] + patches_[n].size();
+  }
+  patch_offsets_.assign(patch_offset_.back(), -1);
+  patch_strides_.assign(patch_stride_.back(), 0);
+  for (size_t n = 0; n < patches_.size(); ++n) {
+    const auto& p = patches_[n];
+    for (size_t j = 0; j < p.size(); ++j) {
+      if (!H.is_fixed(p[j])) patch_strides_[patch_stride_[n] + j] = H.column_stride(p[j]);
+      for (size_t i = 0; i < p.size(); ++i) patch_offsets_[patch_offset_[n] + j * p.size() + i] = H.block_offset(p[i], p[j]);
+    }
+  }
+}
+
+void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const {
+  if (!tet_scatter_.built_for(H)) build_scatter(H);
+  const Eigen::VectorXd J = nodal_volume_ratios(x);
+  const Eigen::Index nt = T_.rows();
+  // dv_t/dx per tetrahedron (12-vectors), for the rank-one patch terms.
+  std::vector<Vec12> dv(nt);
+  std::vector<Mat12> Ke(nt);
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
+    const Vec9 dJ = determinant_gradient(F);
+    dv[t] = tet_gradient_from_stress(Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
+    const Mat9 H9 = element_pressure(J, t) * determinant_hessian(F);
+    Ke[t] = tet_hessian_from_stress_hessian(project_psd ? clamp_to_psd(H9) : H9, rest_[t].Dm_inv, rest_[t].volume);
+  }
+  for (Eigen::Index t = 0; t < nt; ++t) tet_scatter_.add(H, t, Ke[t]);
+  double* values = H.values();
+  // sum_n lambda_n / V_n a_n a_n^T, a_n = sum_{t at n} dv_t/dx / 4 over the patch of n.
+  std::vector<Vec3> a;
+  for (size_t n = 0; n < patches_.size(); ++n) {
+    if (!(Vn_[n] > 0) || lambda_n_[n] == 0) continue;
+    const auto& p = patches_[n];
+    a.assign(p.size(), Vec3::Zero());
+    for (int t : tets_of_[n])
+      for (int k = 0; k < 4; ++k) {
+        const size_t i = std::lower_bound(p.begin(), p.end(), T_(t, k)) - p.begin();
+        a[i] += dv[t].segment<3>(3 * k) / 4;
+      }
+    const double c = lambda_n_[n] / Vn_[n];
+    const long* offs = patch_offsets_.data() + patch_offset_[n];
+    const long* strides = patch_strides_.data() + patch_stride_[n];
+    for (size_t j = 0; j < p.size(); ++j) {
+      const Vec3 aj = c * a[j];
+      for (size_t i = 0; i < p.size(); ++i) {
+        const long off = offs[j * p.size() + i];
+        if (off < 0) continue;
+        for (int k = 0; k < 3; ++k)
+          for (int r = 0; r < 3; ++r) values[off + k * strides[j] + r] += a[i][r] * aj[k];
+      }
+    }
+  }
+}
+
+}  // namespace btr

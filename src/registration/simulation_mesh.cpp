@@ -1,0 +1,40 @@
+#include "breast_tumour_registration/registration/simulation_mesh.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/geometry/tetrahedralize.h"
+#include "breast_tumour_registration/registration/material_regions.h"
+
+namespace btr {
+
+Scene with_simulation_mesh(const Scene& scene, double cell_size) {
+  if (!(cell_size > 0) || !std::isfinite(cell_size))
+    throw InputError("simulation cell size must be positive, got " + std::to_string(cell_size * 1e3) + " mm");
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<int> to_tet;
+  const SurfaceMesh surface = boundary_surface(scene.prone, &to_tet);
+  std::vector<int> surface_index(scene.prone.V.rows(), -1);
+  for (size_t i = 0; i < to_tet.size(); ++i) surface_index[to_tet[i]] = static_cast<int>(i);
+  std::vector<int> wall;
+  for (int v : scene.chest_wall)
+    if (surface_index[v] >= 0) wall.push_back(surface_index[v]);
+
+  Scene out = scene;
+  TetrahedralizeOptions topt;
+  topt.cell_size = cell_size;
+  out.prone = tetrahedralize(surface, topt);
+  out.chest_wall = boundary_vertices_near_region(out.prone, surface, wall, 1e-6 + topt.facet_distance_ratio * cell_size);
+  Points landmarks(static_cast<Eigen::Index>(scene.landmark_anchors.size()), 3);
+  for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
+    landmarks.row(static_cast<Eigen::Index>(i)) = scene.landmark_anchors[i].position(scene.prone.V).transpose();
+  if (landmarks.rows()) out.landmark_anchors = attach_to_boundary(out.prone, landmarks).anchors;
+  if (!scene.prone_labels.empty()) out.prone_labels = transfer_cell_labels(scene.prone, scene.prone_labels, out.prone);
+  out.tetrahedralized = true;
+  out.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace btr

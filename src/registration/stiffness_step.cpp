@@ -1,0 +1,209 @@
+#include "breast_tumour_registration/registration/stiffness_step.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
+#include "breast_tumour_registration/fem/forward_gravity.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+#include "breast_tumour_registration/geometry/rigid_transform.h"
+#include "breast_tumour_registration/registration/unload_step.h"
+
+namespace btr {
+namespace {
+std::string pascal(double e) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.0f Pa", e);
+  return b;
+}
+double sq(double v) { return v * v; }
+}  // namespace
+
+void scale_stiffness(RegistrationModel& model, double scale) {
+  if (!(scale > 0) || !std::isfinite(scale)) throw InputError("stiffness: the scale must be positive");
+  for (auto& m : model.materials) m = StableNeoHookean::from_lame(m.mu() * scale, m.lambda() * scale);
+  model.material.youngs_modulus *= scale;
+}
+
+StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3& prone_gravity,
+                                     const std::vector<Anchor>& anchors, const Points& supine,
+                                     const StiffnessOptions& opt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (anchors.size() < 3 || supine.rows() != static_cast<Eigen::Index>(anchors.size()))
+    throw InputError("stiffness: estimating the Young's modulus needs >= 3 landmark pairs, got " +
+                     std::to_string(std::min<size_t>(anchors.size(), static_cast<size_t>(supine.rows()))));
+  if (!(opt.min_youngs_modulus > 0) || !(opt.max_youngs_modulus > 1.5 * opt.min_youngs_modulus) || opt.grid_points < 3)
+    throw InputError("stiffness: the range must satisfy 0 < min < max / 1.5 [Pa], with >= 3 grid points");
+  const double E0 = model.material.youngs_modulus;
+  const TetMesh prone{model.prone, model.rest.T};
+  StiffnessEstimate est;
+
+  // The last two candidates' (log E, unloaded shape): the next one starts from their
+  // extrapolation, which saves most of the cost of a soft candidate.
+  std::vector<std::pair<double, Points>> known;
+  struct Candidate {
+    double misfit = std::numeric_limits<double>::infinity();
+    Points rest;
+    UnloadResult unload;
+  };
+  auto evaluate = [&](double E) {
+    Candidate c;
+    const double k = E / E0;  // the material scaled by k == the gravities divided by k
+    UnloadProblem pb = unload_problem(model, prone, prone_gravity / k);
+    const double u = std::log(E);
+    Points guess;
+    if (known.size() >= 2) {
+      const auto& [u1, X1] = known[known.size() - 1];
+      const auto& [u0, X0] = known[known.size() - 2];
+      guess = X1 + ((u - u1) / (u1 - u0)) * (X1 - X0);
+      if (count_inverted(guess, model.rest.T) > 0) guess = X1;
+      pb.initial_rest = &guess;
+    } else if (known.size() == 1) {
+      guess = known.back().second;
+      pb.initial_rest = &guess;
+    }
+    c.unload = estimate_unloaded_shape(pb, opt.unload);
+    if (!pb.initial_rest || !c.unload.converged) {  // the extrapolation misled it: from inverse gravity
+      if (pb.initial_rest && !c.unload.converged) {
+        pb.initial_rest = nullptr;
+        UnloadResult fresh = estimate_unloaded_shape(pb, opt.unload);
+        if (fresh.max_mismatch < c.unload.max_mismatch) c.unload = std::move(fresh);
+      }
+    }
+    if (c.unload.converged) {
+      known.emplace_back(u, c.unload.rest);
+      std::sort(known.begin(), known.end(), [&](const auto& a, const auto& b) {
+        return std::abs(a.first - u) > std::abs(b.first - u);  // the nearest last
+      });
+      if (known.size() > 2) known.erase(known.begin());
+    }
+    // A candidate whose unloaded shape does not reproduce the prone shape is not a candidate.
+    if (!(c.unload.max_mismatch < std::max(10 * opt.unload.tolerance, opt.unload.stage_tolerance))) {
+      est.evaluations.emplace_back(E, c.misfit);
+      return c;
+    }
+    c.rest = c.unload.rest;
+    ForwardGravity phi(model.rest.T, model.prone.rows(), model.chest_wall, model.materials, model.material_of,
+                       model.volume_form, model.material.density, opt.unload.forward);
+    Points x = c.rest;
+    try {
+      phi.solve(c.rest, model.gravity / k, x);
+    } catch (const SolverError&) {
+      est.evaluations.emplace_back(E, c.misfit);
+      return c;
+    }
+    Points predicted(static_cast<Eigen::Index>(anchors.size()), 3);
+    for (size_t i = 0; i < anchors.size(); ++i) predicted.row(static_cast<Eigen::Index>(i)) = anchors[i].position(x).transpose();
+    const Rigid T = kabsch(supine, predicted);
+    const Points fitted = transform_points(T, supine);
+    c.misfit = std::sqrt((fitted - predicted).rowwise().squaredNorm().mean());
+    est.evaluations.emplace_back(E, c.misfit);
+    return c;
+  };
+
+  // The grid, from the stiff end; stop once past a clear minimum (two rises above 1.5x the best).
+  const double lo = std::log(opt.min_youngs_modulus), hi = std::log(opt.max_youngs_modulus);
+  std::vector<double> grid_u;
+  std::vector<Candidate> grid;
+  int best = -1, rises = 0;
+  for (int i = opt.grid_points - 1; i >= 0; --i) {
+    const double u = lo + (hi - lo) * i / (opt.grid_points - 1);
+    grid_u.push_back(u);
+    grid.push_back(evaluate(std::exp(u)));
+    const int j = static_cast<int>(grid.size()) - 1;
+    if (best < 0 || grid[j].misfit < grid[best].misfit) {
+      best = j;
+      rises = 0;
+    } else if (std::isfinite(grid[best].misfit) && grid[j].misfit > 1.5 * grid[best].misfit) {
+      if (++rises >= 2) break;
+    }
+  }
+  if (best < 0 || !std::isfinite(grid[best].misfit))
+    throw SolverError("stiffness: no candidate Young's modulus from " + pascal(opt.min_youngs_modulus) + " to " +
+                      pascal(opt.max_youngs_modulus) + " could be unloaded and simulated");
+  double u_best = grid_u[best];
+  Candidate c_best = grid[best];
+  const int n = static_cast<int>(grid.size());
+  est.at_bound = (best == 0 && grid_u[0] >= hi - 1e-12) || (best == n - 1 && grid_u[n - 1] <= lo + 1e-12);
+  // At an end of the range: the point halfway (in log E) to its neighbour tells a minimum
+  // just inside from one beyond the end.
+  std::vector<std::pair<double, double>> bracket;  // (u, misfit) of three points, u ascending
+  if (est.at_bound && n >= 2) {
+    const int nb = best == 0 ? 1 : n - 2;
+    const double um = 0.5 * (grid_u[best] + grid_u[nb]);
+    Candidate c = evaluate(std::exp(um));
+    if (c.misfit < grid[best].misfit) {
+      est.at_bound = false;
+      bracket = {{grid_u[best], grid[best].misfit}, {um, c.misfit}, {grid_u[nb], grid[nb].misfit}};
+      u_best = um;
+      c_best = std::move(c);
+    }
+  } else if (!est.at_bound) {
+    bracket = {{grid_u[best + 1], grid[best + 1].misfit}, {grid_u[best], grid[best].misfit},
+               {grid_u[best - 1], grid[best - 1].misfit}};
+  }
+  std::sort(bracket.begin(), bracket.end());
+  if (est.at_bound) {
+    est.stop_reason = "the best misfit is at the end of the range (" + pascal(std::exp(u_best)) +
+                      "): the estimate is a bound; widen the range";
+  } else {  // the grid stops only after a minimum, and its soft end is lo: best has both neighbours
+    // Parabolic refinement in log E through the best point and its neighbours (grid order is
+    // stiff -> soft, so u decreases with the index).
+    double ua = bracket[0].first, ub = bracket[1].first, uc = bracket[2].first;
+    // On the squared misfit: near an exact fit the misfit grows like |log E - log E*|, its
+    // square like a parabola.
+    double fa = sq(bracket[0].second), fb = sq(bracket[1].second), fc = sq(bracket[2].second);
+    est.stop_reason = "refinement cap (" + std::to_string(opt.max_refinements) + ") reached";
+    for (int it = 0; it < opt.max_refinements; ++it) {
+      if (!std::isfinite(fa) || !std::isfinite(fc)) {
+        est.stop_reason = "a neighbour of the best candidate could not be simulated; the grid point is kept";
+        break;
+      }
+      const double num = (ub - ua) * (ub - ua) * (fb - fc) - (ub - uc) * (ub - uc) * (fb - fa);
+      const double den = (ub - ua) * (fb - fc) - (ub - uc) * (fb - fa);
+      double u = den != 0 ? ub - 0.5 * num / den : ub;
+      u = std::clamp(u, ua + 0.05 * (uc - ua), uc - 0.05 * (uc - ua));  // strictly inside the bracket
+      if (std::abs(u - ub) < std::log1p(opt.relative_tolerance)) {
+        est.converged = true;
+        est.stop_reason = "the refinement moved E by less than " + std::to_string(static_cast<int>(std::lround(opt.relative_tolerance * 100))) + " %";
+        break;
+      }
+      Candidate c = evaluate(std::exp(u));
+      const double fu = sq(c.misfit);
+      if (fu < fb) {  // u becomes the middle point
+        if (u < ub) { uc = ub; fc = fb; } else { ua = ub; fa = fb; }
+        ub = u;
+        fb = fu;
+        c_best = std::move(c);
+        u_best = u;
+      } else {  // u narrows the bracket
+        if (u < ub) { ua = u; fa = fu; } else { uc = u; fc = fu; }
+      }
+    }
+  }
+  est.youngs_modulus = std::exp(u_best);
+  est.scale = est.youngs_modulus / E0;
+  // A candidate is accepted once its unloaded shape reproduces the prone shape within 0.1 mm;
+  // the chosen one is finished from there, so that the unload step's "converged" holds.
+  if (!c_best.unload.converged) {
+    UnloadProblem pb = unload_problem(model, prone, prone_gravity / est.scale);
+    pb.initial_rest = &c_best.rest;
+    UnloadResult polished = estimate_unloaded_shape(pb, opt.unload);
+    if (polished.converged || polished.max_mismatch < c_best.unload.max_mismatch) {
+      polished.seconds += c_best.unload.seconds;
+      c_best.unload = std::move(polished);
+      c_best.rest = c_best.unload.rest;
+    }
+  }
+  est.misfit = c_best.misfit;
+  est.rest = c_best.rest;
+  est.unload = c_best.unload;
+  est.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return est;
+}
+
+}  // namespace btr

@@ -1,0 +1,74 @@
+#include "breast_tumour_registration/registration/unload_step.h"
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
+#include "breast_tumour_registration/geometry/validation.h"
+
+namespace btr {
+
+void set_rest_shape(RegistrationModel& model, const Points& rest, const StepReport& report) {
+  if (rest.rows() != model.prone.rows() || rest.cols() != 3 || !rest.allFinite())
+    throw InputError("unload: the rest shape has " + std::to_string(rest.rows()) + " finite vertices, the model " +
+                     std::to_string(model.prone.rows()));
+  if (count_inverted(rest, model.rest.T) > 0) throw InputError("unload: the rest shape has inverted elements");
+  model.rest.V = rest;
+  model.volume = 0;
+  for (Eigen::Index t = 0; t < model.rest.T.rows(); ++t) model.volume += tet_signed_volume(model.rest.V, model.rest.T, t);
+  model.unload = report;
+}
+
+UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity) {
+  UnloadProblem pb;
+  pb.loaded = &loaded;
+  pb.fixed = model.chest_wall;
+  pb.materials = model.materials;
+  pb.material_of = model.material_of;
+  pb.volume_form = model.volume_form;
+  pb.density = model.material.density;
+  pb.gravity = gravity;
+  return pb;
+}
+
+StepReport unload_report(const UnloadResult& u, const Points& prone) {
+  StepReport rep;
+  rep.name = "unload";
+  rep.converged = u.converged;
+  rep.stop_reason = u.stop_reason;
+  rep.iterations = u.newton_iterations;
+  rep.outer_iterations = u.iterations;
+  rep.seconds = u.seconds;
+  rep.unload_mismatch = u.max_mismatch;
+  rep.unload_forward_solve_equivalents = u.forward_solve_equivalents;
+  rep.unload_load_steps = u.load_steps;
+  rep.unload_rest_change = u.rest.rows() == prone.rows() ? (u.rest - prone).rowwise().norm().maxCoeff() : 0.0;
+  return rep;
+}
+
+StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options) {
+  if (!prone_gravity.allFinite() || !(prone_gravity.norm() > 0))
+    throw InputError("prone_gravity: must be a finite, non-zero vector [m/s^2]");
+  const TetMesh loaded{model.prone, model.rest.T};
+  const UnloadResult u = estimate_unloaded_shape(unload_problem(model, loaded, prone_gravity), options);
+
+  StepReport rep = unload_report(u, model.prone);
+  // The prone shape as rest misses the prone shape by about the sag; the estimate is kept when
+  // it does better than that (always, when converged).
+  const double prone_as_rest_mismatch = u.inverse_gravity_lift;
+  const bool better = u.converged || (!u.mismatch_history.empty() && u.max_mismatch < prone_as_rest_mismatch);
+  if (!better) {
+    rep.note = "no unloaded shape better than the prone shape was found (" + u.stop_reason +
+               "); the prone shape stays the rest shape";
+    rep.unload_rest_change = 0;
+    model.unload = rep;
+    return rep;
+  }
+  if (!u.converged)
+    rep.note = "stopped before converging (" + u.stop_reason + "); its best estimate reproduces the prone shape within " +
+               format_mm(u.max_mismatch, 2) + " (the prone shape as rest: about " + format_mm(prone_as_rest_mismatch, 1) +
+               ") and is used";
+  set_rest_shape(model, u.rest, rep);
+  return rep;
+}
+
+}  // namespace btr

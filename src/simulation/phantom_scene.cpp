@@ -1,0 +1,200 @@
+#include "breast_tumour_registration/simulation/phantom_scene.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
+#include "breast_tumour_registration/simulation/rest_model_io.h"
+
+namespace btr {
+
+std::vector<int> phantom_tissue_labels(const PhantomModel& model, const PhantomSceneOptions& opt) {
+  if (opt.gland_youngs_modulus < 0 || opt.tumour_youngs_modulus < 0 || !std::isfinite(opt.gland_youngs_modulus) ||
+      !std::isfinite(opt.tumour_youngs_modulus))
+    throw InputError("phantom: gland and tumour Young's moduli must be >= 0 (0: the body's material)");
+  if (opt.gland_youngs_modulus == 0 && opt.tumour_youngs_modulus == 0) return {};
+  std::vector<int> labels(model.rest.T.rows(), kPhantomFatLabel);
+  if (opt.gland_youngs_modulus > 0) {
+    if (model.gland.F.rows() == 0) throw InputError("phantom: the rest model has no gland region to stiffen");
+    for (int t : tetrahedra_inside(model.rest, {&model.gland})) labels[t] = kPhantomGlandLabel;
+  }
+  if (opt.tumour_youngs_modulus > 0) {
+    std::vector<const SurfaceMesh*> tumours;
+    for (const auto& [name, t] : model.tumours) tumours.push_back(&t);
+    for (int t : tetrahedra_inside(model.rest, tumours)) labels[t] = kPhantomTumourLabel;
+  }
+  return labels;
+}
+
+PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomSceneOptions& opt,
+                                       const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
+  StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio);  // validates before the expensive steps
+  const std::vector<int> labels = phantom_tissue_labels(model, opt);
+  std::vector<int> material_of;  // label 1, 2, 3 -> body, gland, tumour material
+  std::vector<double> region_E;
+  if (!labels.empty()) {
+    std::vector<int> index_of(4, 0);
+    if (opt.gland_youngs_modulus > 0) {
+      region_E.push_back(opt.gland_youngs_modulus);
+      index_of[kPhantomGlandLabel] = static_cast<int>(region_E.size());
+    }
+    if (opt.tumour_youngs_modulus > 0) {
+      region_E.push_back(opt.tumour_youngs_modulus);
+      index_of[kPhantomTumourLabel] = static_cast<int>(region_E.size());
+    }
+    for (int l : labels) material_of.push_back(index_of[l]);
+  }
+  auto solve = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
+    GravityProblem pb;
+    pb.rest = &model.rest;
+    pb.fixed = model.chest_wall;
+    pb.youngs_modulus = opt.youngs_modulus;
+    pb.poisson_ratio = opt.poisson_ratio;
+    pb.volume_form = opt.volume_form;
+    pb.density = opt.density;
+    pb.gravity = g;
+    pb.material_of = material_of;
+    pb.region_youngs_modulus = region_E;
+    NewtonOptions newton;
+    if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
+    GravityResult r = solve_gravity(pb, newton);
+    if (!r.newton.converged) throw SolverError(name + " solve did not converge: " + to_string(r.newton.reason));
+    out = r.newton;
+    return r.x;
+  };
+  PhantomConfigurations c;
+  c.labels = labels;
+  c.prone = solve("prone", model.prone_gravity, c.prone_newton);
+  c.supine = solve("supine", model.supine_gravity, c.supine_newton);
+  for (const auto& [name, t] : model.tumours) {
+    const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
+    c.tumour_prone[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.prone), t.F};
+    c.tumour_supine[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.supine), t.F};
+  }
+  return c;
+}
+
+PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSceneOptions& opt,
+                                        const std::function<bool(const std::string&, const IterationInfo&)>& progress) {
+  namespace fs = std::filesystem;
+  const auto landmark_names = phantom_landmark_set(opt.landmark_set);
+  StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio);  // validates before the expensive steps
+  fs::create_directories(dir);
+  const PhantomModel model = make_phantom_model(opt.phantom);
+  PhantomSceneSummary sum;
+  sum.vertices = model.rest.V.rows();
+  sum.tetrahedra = model.rest.T.rows();
+  sum.chest_wall_vertices = static_cast<long>(model.chest_wall.size());
+  sum.quality = tet_quality(model.rest);
+  const PhantomConfigurations conf = simulate_phantom(model, opt, progress);
+  sum.prone = conf.prone_newton;
+  sum.supine = conf.supine_newton;
+  const Points& prone = conf.prone;
+  const Points& supine = conf.supine;
+
+  auto path = [&](const std::string& f) { return (fs::path(dir) / f).string(); };
+  const LengthUnit unit = opt.units;
+  write_rest_model(dir, model, unit);  // rest.vtk, chest_wall.txt, chest_ring.obj, tumours, model.yaml
+  TetMesh m = model.rest;
+  m.V = prone;
+  write_tet_mesh(path("prone.vtk"), m, unit, conf.labels);  // the tissue labels a segmentation would give
+  write_surface(path("prone_surface.obj"), boundary_surface(m), unit);
+  m.V = supine;
+  write_tet_mesh(path("supine.vtk"), m, unit);
+  write_surface(path("supine_surface.obj"), boundary_surface(m), unit);
+
+  std::vector<LandmarkPair> pairs;
+  YAML::Node lm_vertices;
+  for (const auto& [name, v] : model.landmarks) lm_vertices[name] = v;
+  for (const auto& name : landmark_names) {
+    LandmarkPair p;
+    p.prone_vertex = model.landmarks.at(name);
+    p.supine_point = supine.row(p.prone_vertex).transpose();
+    pairs.push_back(p);
+  }
+  write_landmark_pairs(path("landmarks.csv"), pairs, unit);
+
+  YAML::Node tumours;
+  for (const auto& name : phantom_tumour_names()) {
+    const SurfaceMesh& tp = conf.tumour_prone.at(name);
+    const SurfaceMesh& ts = conf.tumour_supine.at(name);
+    write_surface(path("tumour_" + name + "_prone.obj"), tp, unit);
+    write_surface(path("tumour_" + name + "_supine.obj"), ts, unit);
+    YAML::Node n;
+    n["name"] = name;
+    n["prone"] = "tumour_" + name + "_prone.obj";
+    n["supine_ground_truth"] = "tumour_" + name + "_supine.obj";
+    n["rest"] = "tumour_" + name + "_rest.obj";
+    tumours.push_back(n);
+    sum.tumour_displacement.emplace_back(name, (volume_centroid(ts) - volume_centroid(tp)).norm());
+  }
+
+  YAML::Node scene;
+  scene["units"] = to_string(unit);
+  scene["frame"] = "chest wall in z = 0, breast towards +z; prone gravity +z, supine gravity -z";
+  scene["prone"]["tet_mesh"] = "prone.vtk";
+  scene["prone"]["surface"] = "prone_surface.obj";
+  scene["rest"]["tet_mesh"] = "rest.vtk";
+  scene["rest"]["surface"] = "rest_surface.obj";
+  scene["chest_wall"] = "chest_wall.txt";
+  scene["chest_ring"] = "chest_ring.obj";
+  scene["supine"]["surface"] = "supine_surface.obj";
+  scene["supine"]["chest_ring"] = "chest_ring.obj";
+  scene["supine"]["tet_mesh_ground_truth"] = "supine.vtk";
+  scene["landmarks"] = "landmarks.csv";
+  scene["landmark_set"] = opt.landmark_set;
+  scene["landmark_vertices"] = lm_vertices;
+  scene["tumours"] = tumours;
+  // Heterogeneous truth: the method is told the tissue layout (the labels) and the stiffness
+  // ratios, not the absolute moduli (its body material stays the thesis's, or is estimated).
+  if (!conf.labels.empty()) {
+    if (opt.gland_youngs_modulus > 0) {
+      write_surface(path("gland_rest.obj"), model.gland, unit);
+      const Embedding emb = embed_points(model.rest, model.gland.V, OutsidePolicy::Error);
+      write_surface(path("gland_prone.obj"), SurfaceMesh{apply_embedding(emb, model.rest.T, prone), model.gland.F}, unit);
+    }
+    YAML::Node regions;
+    auto region = [&](const char* name, int label, double E) {
+      if (E <= 0) return;
+      YAML::Node r;
+      r["name"] = name;
+      r["label"] = label;
+      r["relative_stiffness"] = E / opt.youngs_modulus;
+      regions.push_back(r);
+    };
+    region("gland", kPhantomGlandLabel, opt.gland_youngs_modulus);
+    region("tumour", kPhantomTumourLabel, opt.tumour_youngs_modulus);
+    scene["regions"] = regions;
+  }
+  scene["material"]["youngs_modulus"] = 3400.0;
+  scene["material"]["poisson_ratio"] = 0.49;
+  scene["material"]["density"] = 1000.0;
+  scene["gravity"] = std::vector<double>{0.0, 0.0, -9.81};
+  scene["steps"] = "auto";
+  scene["preset"] = "balanced";
+  scene["generator"]["youngs_modulus"] = opt.youngs_modulus;
+  scene["generator"]["poisson_ratio"] = opt.poisson_ratio;
+  scene["generator"]["volume_form"] = to_string(resolve_volume_form(opt.volume_form, opt.poisson_ratio));
+  scene["generator"]["density"] = opt.density;
+  scene["generator"]["tumour_youngs_modulus"] = opt.tumour_youngs_modulus;
+  scene["generator"]["gland_youngs_modulus"] = opt.gland_youngs_modulus;
+  scene["generator"]["cell_size_mm"] = opt.phantom.tet.cell_size * 1e3;
+  scene["generator"]["tetrahedra"] = sum.tetrahedra;
+  YAML::Emitter y;
+  y << scene;
+  std::ofstream(path("scene.yaml")) << "# Synthetic breast phantom (thesis Sec. 5.2.1) written by btr_phantom\n"
+                                    << "# The registration uses the thesis's fixed material (E = 3400 Pa), not the generator's.\n"
+                                    << y.c_str() << "\n";
+  return sum;
+}
+
+}  // namespace btr

@@ -1,0 +1,107 @@
+// The live registration's scene (what the node's ~register does with use_latest_cloud), tested
+// without ROS: the scan replaces the supine side and the tracked pose moves what stays of it.
+#include <filesystem>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/organized_cloud.h"
+#include "breast_tumour_registration/registration/live_scene.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/simulation/depth_camera.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
+#include "test_util.h"
+
+using namespace btr;
+using btr::test::expect_throw_with;
+using btr::test::make_rigid;
+
+namespace {
+
+const Scene& live_phantom() {
+  static const Scene s = [] {
+    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom_live").string();
+    std::filesystem::remove_all(d);
+    PhantomSceneOptions o;
+    o.phantom.tet.cell_size = 0.012;
+    o.phantom.surface_rings = 12;
+    write_phantom_scene(d, o);
+    return load_scene(d + "/scene.yaml");
+  }();
+  return s;
+}
+
+// The supine skin seen by a camera 0.4 m above the breast, in the working frame, where the
+// scene's supine frame sits at `supine_to_working`.
+LiveScan scan_of(const Scene& s, const Rigid& supine_to_working) {
+  const SurfaceMesh skin = transform_surface(supine_to_working, *s.supine_surface);
+  const Vec3 centre = skin.V.colwise().mean().transpose();
+  PinholeCamera cam;
+  cam.width = 80;
+  cam.height = 60;
+  cam.fx = cam.fy = 70;
+  cam.cx = 39.5;
+  cam.cy = 29.5;
+  const Rigid camera_to_working = look_at(centre + supine_to_working.linear() * Vec3(0, 0, 0.4), centre, Vec3(0, 1, 0));
+  LiveScan scan;
+  scan.cloud = transform_points(camera_to_working, render_depth({&skin}, cam, camera_to_working));
+  scan.width = cam.width;
+  scan.height = cam.height;
+  scan.supine_to_working = supine_to_working;
+  return scan;
+}
+
+}  // namespace
+
+TEST(LiveScene, AnOrganizedScanBecomesTheSupineSurfaceAndThePoseMovesTheRest) {
+  const Scene& s = live_phantom();
+  const Rigid T = make_rigid(Vec3(3, -2, 10), Vec3(0.02, -0.01, 0.05));
+  const LiveScene live = live_scene(s, scan_of(s, T));
+  ASSERT_TRUE(live.scene.supine_surface);
+  EXPECT_FALSE(live.scene.supine_cloud);
+  EXPECT_FALSE(live.scene.supine_rigid);  // the scan replaces the supine side
+  EXPECT_GT(live.scene.supine_surface->F.rows(), 100);
+  EXPECT_TRUE(live.scene.steps.empty());
+  EXPECT_TRUE((live.known_supine_to_model * T).matrix().isIdentity(1e-12));
+  ASSERT_EQ(live.scene.landmark_supine.rows(), s.landmark_supine.rows());
+  for (Eigen::Index i = 0; i < s.landmark_supine.rows(); ++i)
+    EXPECT_LT((live.scene.landmark_supine.row(i).transpose() - T * Vec3(s.landmark_supine.row(i).transpose())).norm(), 1e-12);
+  EXPECT_LT((live.scene.tumours[0].supine_ground_truth->V.row(0).transpose() -
+             T * Vec3(s.tumours[0].supine_ground_truth->V.row(0).transpose())).norm(), 1e-12);
+  // Registered with the tracked pose, the live scene lands on the truth as the file scene does.
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(s, warnings);
+  RegistrationOptions opt = preset_options("balanced");
+  opt.known_supine_to_model = live.known_supine_to_model;
+  const RegistrationResult r = run_registration(live.scene, m, opt);
+  EXPECT_FALSE(r.steps.rigid_icp || r.steps.rigid_landmarks);
+  for (const auto& t : r.tumours) EXPECT_LT(t.centroid_distance, 1e-3) << t.name;  // a partial view of the skin
+}
+
+TEST(LiveScene, AnUnorganizedScanIsUsedAsItsFinitePointsAndLandmarksCanBeLeftOut) {
+  const Scene& s = live_phantom();
+  LiveScan scan = scan_of(s, Rigid::Identity());
+  const Eigen::Index finite = finite_points(scan.cloud).rows();
+  ASSERT_LT(finite, scan.cloud.rows());  // the camera sees background pixels as NaN
+  scan.width = scan.height = 0;
+  LiveSceneOptions o;
+  o.use_landmarks = false;
+  const LiveScene live = live_scene(s, scan, o);
+  EXPECT_FALSE(live.scene.supine_surface);
+  ASSERT_TRUE(live.scene.supine_cloud);
+  EXPECT_EQ(live.scene.supine_cloud->rows(), finite);
+  EXPECT_TRUE(live.scene.supine_cloud->allFinite());
+  EXPECT_TRUE(live.scene.landmark_anchors.empty());
+  EXPECT_EQ(live.scene.landmark_supine.rows(), 0);
+}
+
+TEST(LiveScene, AScanThatGivesNothingIsAClearError) {
+  const Scene& s = live_phantom();
+  LiveScan nan_scan;
+  nan_scan.cloud = Points::Constant(12, 3, std::numeric_limits<double>::quiet_NaN());
+  nan_scan.width = 4;
+  nan_scan.height = 3;
+  expect_throw_with<InputError>([&] { live_scene(s, nan_scan); }, "yields no surface");
+  nan_scan.width = 5;
+  expect_throw_with<InputError>([&] { live_scene(s, nan_scan); }, "not organized");
+  nan_scan.width = nan_scan.height = 0;
+  expect_throw_with<InputError>([&] { live_scene(s, nan_scan); }, "no finite point");
+}
