@@ -21,7 +21,8 @@ field), and three scenes:
   scene_estimated.yaml  prone_gravity and youngs_modulus: estimate
 and, with the tissue layout given as regions (the prone gland surface gland_prone.obj, 2x, and
 the prone tumour surfaces, 6x: the ratios, not the moduli), the method told the heterogeneity:
-  scene_unloaded_regions.yaml, scene_estimated_regions.yaml
+  scene_unloaded_regions.yaml, scene_estimated_regions.yaml, and the last with the nodal volume
+  term (scene_estimated_regions_nodal.yaml)
 and truth.json (moduli, sags, load steps, seconds).
 
 Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
@@ -178,6 +179,10 @@ def write_scenes(d, fat_e, gland_ratio, tumour_ratio):
                 for n in names]
     variants['unloaded_regions'] = variants['unloaded'] + regions
     variants['estimated_regions'] = variants['estimated'] + regions
+    # The volume term on nodal averages: linear tetrahedra lock at nu = 0.49 (the truth's P2 do not).
+    variants['estimated_regions_nodal'] = [
+        'material: {youngs_modulus: estimate, poisson_ratio: 0.49, density: 1000, volume_form: nodal}',
+        'prone_gravity: [0, 0, 9.81]'] + regions
     for name, extra in variants.items():
         with open(os.path.join(d, 'scene_%s.yaml' % name), 'w') as f:
             f.write('# Independent truth (SfePy, P2, heterogeneous, fat E = %g Pa): bench/make_independent_truth.py\n' % fat_e)

@@ -17,7 +17,7 @@ set -u
 for E in $MODULI; do
   [ -f "$OUT/E$E/truth.json" ] || PYTHONUNBUFFERED=1 /usr/bin/python3 "$here/make_independent_truth.py" "$OUT" \
     --fat-youngs-moduli "$E" --max-volume "${MAX_VOLUME:-5000}"
-  for v in prone unloaded estimated unloaded_regions estimated_regions; do
+  for v in prone unloaded estimated unloaded_regions estimated_regions estimated_regions_nodal; do
     rosrun breast_tumour_registration btr_register "$OUT/E$E/scene_$v.yaml" --quiet --out "$OUT/E$E/reg_$v" \
       > "$OUT/E$E/reg_$v.log" 2>&1 || true  # exit 4/5 (not converged / implausible) still writes the report
   done
@@ -49,6 +49,6 @@ PY
 for E in $MODULI; do
   d=$OUT/E$E
   echo "### fat E = $E Pa: tumour shape"
-  /usr/bin/python3 "$here/summarize_tumours.py" $(for v in prone unloaded estimated unloaded_regions estimated_regions; do
+  /usr/bin/python3 "$here/summarize_tumours.py" $(for v in prone unloaded estimated unloaded_regions estimated_regions estimated_regions_nodal; do
     echo "$v=$d/reg_$v/report.json"; done)
 done

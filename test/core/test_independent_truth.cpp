@@ -17,8 +17,8 @@ struct Outcome {
   bool converged = false;
 };
 
-Outcome register_independent(const std::string& variant) {
-  const Scene s = load_scene(std::string(BTR_TEST_DATA_DIR) + "/independent_truth_E3400/scene_" + variant + ".yaml");
+Outcome register_independent(const std::string& variant, const std::string& fat = "3400") {
+  const Scene s = load_scene(std::string(BTR_TEST_DATA_DIR) + "/independent_truth_E" + fat + "/scene_" + variant + ".yaml");
   std::vector<std::string> warnings;
   const RegistrationModel m = prepare_model(s, warnings);
   const RegistrationResult r = run_registration(s, m, preset_options(s.preset));
@@ -29,9 +29,9 @@ Outcome register_independent(const std::string& variant) {
     o.rigid_only = std::max(o.rigid_only, t.rigid_centroid_distance);
     o.axis_gap = std::max(o.axis_gap, std::abs(t.axis_ratio - t.truth_axis_ratio) / t.truth_axis_ratio);
   }
-  std::printf("independent truth (SfePy, fat 3400 Pa), %-17s: worst tumour %.3f mm (rigid only %.3f mm), axis-ratio gap "
+  std::printf("independent truth (SfePy, fat %s Pa), %-17s: worst tumour %.3f mm (rigid only %.3f mm), axis-ratio gap "
               "%.1f %%, %s%s\n",
-              variant.c_str(), o.worst * 1e3, o.rigid_only * 1e3, 100 * o.axis_gap, r.converged ? "converged" : "not converged",
+              fat.c_str(), variant.c_str(), o.worst * 1e3, o.rigid_only * 1e3, 100 * o.axis_gap, r.converged ? "converged" : "not converged",
               r.steps.stiffness ? (", E estimated " + std::to_string(static_cast<int>(r.estimated_youngs_modulus)) + " Pa").c_str() : "");
   return o;
 }
@@ -54,4 +54,21 @@ TEST(IndependentTruth, EveryPlanBeatsRigidAlignmentAndTheUnloadedShapeBeatsThePr
   // The tumours' stiffness keeps their shape: the gap to the truth's axis ratio halves.
   EXPECT_LT(regions.axis_gap, 0.7 * unloaded.axis_gap);
   EXPECT_LT(estimated.axis_gap, 0.05);
+}
+
+TEST(IndependentTruth, AtSoftFatTheFullMethodNeedsTheRegionsTheStiffnessAndALockingFreeVolumeTerm) {
+  // Fat at 1000 Pa (prone sag 8 mm): the prone shape as rest is barely better than rigid
+  // alignment. The unloaded shape at an estimated E with the tissue regions is better, and far
+  // better with the volume term on nodal averages: the truth's quadratic elements do not lock
+  // at nu = 0.49, the method's linear ones do with the element form (the default at 0.49, for
+  // speed). Our own phantom cannot show this: its truth locks in the same way. Figures printed;
+  // BENCHMARKS.md, "Heterogeneous tissue".
+  const Outcome prone = register_independent("prone", "1000"), full = register_independent("estimated_regions", "1000"),
+                nodal = register_independent("estimated_regions_nodal", "1000");
+  EXPECT_TRUE(full.converged);
+  EXPECT_TRUE(nodal.converged);
+  EXPECT_LT(prone.worst, prone.rigid_only);
+  EXPECT_LT(full.worst, 0.5 * prone.worst);
+  EXPECT_LT(nodal.worst, 0.5 * full.worst);
+  EXPECT_LT(nodal.worst, 0.6e-3);
 }
