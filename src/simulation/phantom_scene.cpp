@@ -8,6 +8,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
@@ -68,6 +69,13 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     if (progress) newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
     GravityResult r = solve_gravity(pb, newton);
     if (!r.newton.converged) throw SolverError(name + " solve did not converge: " + to_string(r.newton.reason));
+    // A truth with folded elements is no truth (and no valid prone mesh): the element volume
+    // term keeps each tetrahedron from inverting, the nodal one only their patches.
+    if (const long inverted = count_inverted(r.x, model.rest.T); inverted > 0)
+      throw SolverError(name + " configuration has " + std::to_string(inverted) + " inverted tetrahedra under this load (E " +
+                        std::to_string(static_cast<int>(opt.youngs_modulus)) + " Pa, " +
+                        to_string(resolve_volume_form(opt.volume_form, opt.poisson_ratio)) +
+                        " volume term): use a finer mesh, a stiffer material or the element volume term");
     out = r.newton;
     return r.x;
   };

@@ -2,11 +2,13 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/validation.h"
 #include "breast_tumour_registration/simulation/phantom.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "test_util.h"
 
 using namespace btr;
@@ -85,4 +87,20 @@ TEST(Phantom, ProneHangsAndSupineFlattensWithTheChestWallFixed) {
   pb.youngs_modulus = 12000;
   const GravityResult stiff = solve_gravity(pb, NewtonOptions{});
   EXPECT_GT(stiff.x(apex, 2) - m.rest.V(apex, 2), down);
+}
+
+TEST(Phantom, ATruthWithFoldedElementsIsRefusedWithItsCause) {
+  // The nodal volume term keeps patches, not single tetrahedra, from inverting: at 600 Pa on the
+  // coarse 12 mm phantom one element folds in the prone sag. Before, that truth was written and
+  // only refused later, as a prone mesh, by the registration.
+  PhantomOptions po;  // btr_phantom -E 600 --cell-size 12 --volume-form nodal
+  po.tet.cell_size = 0.012;
+  const PhantomModel model = make_phantom_model(po);
+  PhantomSceneOptions so;
+  so.youngs_modulus = 600;
+  so.volume_form = VolumeForm::Nodal;
+  btr::test::expect_throw_with<SolverError>([&] { simulate_phantom(model, so); }, "inverted tetrahedra under this load");
+  so.volume_form = VolumeForm::Element;
+  const PhantomConfigurations c = simulate_phantom(model, so);
+  EXPECT_EQ(count_inverted(c.prone, model.rest.T), 0);
 }
