@@ -15,7 +15,8 @@
 namespace btr {
 
 StepReport landmark_step(const RegistrationModel& model, const std::vector<Anchor>& anchors, const Points& targets,
-                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback, Rigid* pose) {
+                         const LandmarkStepOptions& opt, Points& x, const StepCallback& callback, Rigid* pose,
+                         StepSolvers* cache) {
   const auto t0 = std::chrono::steady_clock::now();
   if (anchors.empty()) throw InputError("landmark step: no landmarks");
   if (static_cast<Eigen::Index>(anchors.size()) != targets.rows())
@@ -56,8 +57,10 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
   } else {
     energy.add(springs);
   }
-  const SkinningSubspace S = build_skinning_subspace(model.rest.V, model.volume, seeds, model.fixed, opt.subspace);
-  HessianAssembler H(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed, energy.hessian_cliques(cliques));
+  StepSolvers local;  // without an engine's cache: built for this call only
+  StepSolvers& solvers = cache ? *cache : local;
+  const SkinningSubspace& S = solvers.subspace(model, seeds, opt.subspace);
+  HessianAssembler& H = solvers.newton(pose ? "landmark (pose free)" : "landmark", model, energy.hessian_cliques(cliques)).assembler();
   NewtonOptions nopt = opt.newton;
   if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
   if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("landmark", it); };

@@ -15,7 +15,8 @@
 namespace btr {
 
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
-                        Points& x, const StepCallback& callback, Rigid* pose, const PosePoints* pose_points) {
+                        Points& x, const StepCallback& callback, Rigid* pose, const PosePoints* pose_points,
+                        StepSolvers* cache) {
   const auto t0 = std::chrono::steady_clock::now();
   if (opt.max_projections < 1 || opt.newton_per_projection < 1)
     throw InputError("surface step: max_projections and newton_per_projection must be >= 1");
@@ -34,9 +35,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     energy.add(points);
     energy.add(planes);
   }
-  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed,
-                                                         energy.hessian_cliques()),
-                      model.rest.T);
+  StepSolvers local;  // without an engine's cache: built for this call only
+  NewtonSolver& solver = (cache ? *cache : local).newton(pose ? "surface (pose free)" : "surface", model, energy.hessian_cliques());
   NewtonOptions nopt = opt.newton;
   nopt.max_iterations = opt.newton_per_projection;
   if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();

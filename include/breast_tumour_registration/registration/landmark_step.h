@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/geometry/anchor.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/registration/registration_model.h"
+#include "breast_tumour_registration/registration/step_solvers.h"
 
 namespace btr {
 
@@ -25,8 +26,10 @@ struct LandmarkStepOptions {
 /// pose == nullptr: the targets stay where they are. Otherwise the targets may move rigidly
 /// and their pose is solved jointly with the deformation (RigidFreeLandmarkEnergy; needs
 /// >= 3 landmarks); on return *pose maps the given targets to where they ended.
+/// cache: an engine's solvers for this model (the subspace and the Hessian pattern are reused
+/// while unchanged); nullptr builds them for this call.
 StepReport landmark_step(const RegistrationModel& model, const std::vector<Anchor>& anchors, const Points& targets,
                          const LandmarkStepOptions& opt, Points& x, const StepCallback& callback = {},
-                         Rigid* pose = nullptr);
+                         Rigid* pose = nullptr, StepSolvers* cache = nullptr);
 
 }  // namespace btr

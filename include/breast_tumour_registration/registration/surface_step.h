@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/geometry/surface_projector.h"
 #include "breast_tumour_registration/registration/registration_model.h"
+#include "breast_tumour_registration/registration/step_solvers.h"
 
 namespace btr {
 
@@ -46,12 +47,14 @@ struct SurfaceStepOptions {
 /// model frame into the frame the projector was given in.
 /// pose_points (with a free pose only): point correspondences such as the landmarks, targets
 /// in the projector's frame, that share the pose (opt.pose_points_weight).
+/// cache: an engine's solvers for this model (the Hessian pattern and its symbolic analysis
+/// are reused while unchanged); nullptr builds them for this call.
 struct PosePoints {
   std::vector<Anchor> anchors;
   Points targets;
 };
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
                         Points& x, const StepCallback& callback = {}, Rigid* pose = nullptr,
-                        const PosePoints* pose_points = nullptr);
+                        const PosePoints* pose_points = nullptr, StepSolvers* cache = nullptr);
 
 }  // namespace btr
