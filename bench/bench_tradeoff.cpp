@@ -13,11 +13,12 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <vector>
 
 #include "breast_tumour_registration/base/errors.h"
-#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
 
 using namespace btr;
@@ -91,23 +92,24 @@ int main(int argc, char** argv) {
     if (!csv) throw InputError("cannot write '" + out_path + "'");
     csv << "knob,value,base_preset,cell_size_mm,tetrahedra,prepare_seconds,seconds_median,worst_error_mm,mean_error_mm,"
            "converged\n";
-    // One prepared model per simulation mesh (as a node caches it).
-    std::map<double, std::pair<Scene, RegistrationModel>> models;
+    // One engine per simulation mesh (as the node keeps it): prepared once, solved repeatedly.
+    std::map<double, std::unique_ptr<RegistrationEngine>> engines;
     std::map<double, double> prepare_seconds;
     for (const Point& p : points) {
-      if (!models.count(p.cell_mm)) {
+      if (!engines.count(p.cell_mm)) {
         const auto t0 = std::chrono::steady_clock::now();
         Scene s = p.cell_mm > 0 ? with_simulation_mesh(scene, p.cell_mm * 1e-3) : scene;
         std::vector<std::string> warnings;
         RegistrationModel m = prepare_model(s, warnings);
         prepare_seconds[p.cell_mm] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        models.emplace(p.cell_mm, std::make_pair(std::move(s), std::move(m)));
+        engines.emplace(p.cell_mm, std::make_unique<RegistrationEngine>(std::move(s), std::move(m), std::move(warnings)));
       }
-      const auto& [s, m] = models.at(p.cell_mm);
+      RegistrationEngine& engine = *engines.at(p.cell_mm);
+      const RegistrationModel& m = engine.prepare(p.opt).model;
       std::vector<double> secs;
       RegistrationResult r;
       for (int i = 0; i < repeats; ++i) {
-        r = run_registration(s, m, p.opt);
+        r = engine.solve(p.opt);
         secs.push_back(r.seconds);
       }
       double worst = 0, mean = 0;

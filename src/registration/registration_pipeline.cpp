@@ -137,12 +137,15 @@ PlannedSteps plan_steps(const Scene& s) {
   return p;
 }
 
-std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt) {
-  if (opt.simulation_cell_size <= 0) return std::nullopt;
-  const double mean_edge = mean_edge_length(scene.prone);
+bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt) {
+  if (opt.simulation_cell_size <= 0) return false;
   // CGAL's meshes at cell size c have a mean edge of about 1.35 c (1.34 measured on the
   // phantom at 4.7 mm): remesh only a scene mesh clearly finer than that.
-  if (mean_edge >= 1.1 * opt.simulation_cell_size) return std::nullopt;
+  return mean_edge_length(scene.prone) < 1.1 * opt.simulation_cell_size;
+}
+
+std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt) {
+  if (!needs_simulation_mesh(scene, opt)) return std::nullopt;
   return with_simulation_mesh(scene, opt.simulation_cell_size);
 }
 
@@ -169,7 +172,10 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
 }
 
 RegistrationResult run_registration(const Scene& scene, const RegistrationModel& prepared, const RegistrationOptions& opt,
-                                    const StepCallback& callback) {
+                                    const StepCallback& callback, StepSolvers* solvers) {
+  // With the stiffness step the steps simulate a per-call copy of the model: its materials and
+  // rest shape differ, its mesh, fixed vertices and cliques do not, so the cached patterns still
+  // apply (the subspace, built on the rest shape, is rebuilt).
   const auto t_start = Clock::now();
   RegistrationResult r;
   r.warnings = scene.warnings;
@@ -269,9 +275,8 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     add_model_elastic_energy(energy, model);
     auto g = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
     energy.add(g);
-    NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(model.rest.V.rows()), model.rest.T, model.fixed,
-                                                         energy.hessian_cliques()),
-                        model.rest.T);
+    StepSolvers local;
+    NewtonSolver& solver = (solvers ? *solvers : local).newton("gravity", model, energy.hessian_cliques());
     NewtonOptions nopt = opt.gravity;
     nopt.force_scale = g->total_weight();
     if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("gravity", it); };
@@ -292,17 +297,17 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   if (r.steps.landmarks) {
     if (joint_pose && !r.icp_used) {
       Rigid moved = Rigid::Identity();
-      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback, &moved));
+      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback, &moved, solvers));
       T = moved * T;
       targets = transform_points(moved, targets);
       r.pose_solved_with_landmarks = true;
     } else {
-      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback));
+      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback, nullptr, solvers));
       if (joint_pose) {
         // ICP decided the pose; the joint fit (warm-started from this result) checks it.
         Points xj = r.x;
         Rigid moved = Rigid::Identity();
-        const StepReport check = landmark_step(model, scene.landmark_anchors, targets, opt.landmark, xj, {}, &moved);
+        const StepReport check = landmark_step(model, scene.landmark_anchors, targets, opt.landmark, xj, {}, &moved, solvers);
         r.pose_disagreement = max_displacement(moved, Rigid::Identity(), scene.prone_rigid->V);
         if (r.pose_disagreement > opt.pose_disagreement_warning)
           r.warnings.push_back("rigid alignment: ICP on the rigid regions and the pose solved with the landmarks differ by " +
@@ -325,7 +330,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     const bool free_pose = (r.steps.rigid_landmarks || r.steps.rigid_icp) && !r.icp_used;
     PosePoints lm{scene.landmark_anchors, targets};
     r.reports.push_back(surface_step(model, *supine, opt.surface, r.x, callback, free_pose ? &to_projector : nullptr,
-                                     targets.rows() >= 3 ? &lm : nullptr));
+                                     targets.rows() >= 3 ? &lm : nullptr, solvers));
     r.pose_solved_with_surface = free_pose;
     T = to_projector.inverse() * T;
     if (targets.rows()) targets = transform_points(to_projector.inverse(), targets);

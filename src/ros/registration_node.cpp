@@ -126,13 +126,12 @@ void RegistrationNode::load_scene() {
   try {
     if (params_.scene.empty()) throw InputError("parameter ~scene is not set (path of a scene YAML file)");
     const auto t0 = std::chrono::steady_clock::now();
-    Scene scene = btr::load_scene(params_.scene);
-    std::vector<std::string> warnings;
-    RegistrationModel model = prepare_model(scene, warnings);
-    loaded_ = std::make_shared<const Simulation>(Simulation{std::move(scene), std::move(model)});
-    const Scene& s = loaded_->scene;
-    for (const auto& w : warnings) ROS_WARN_STREAM("scene: " << w);
-    simulation_for(preset_options(params_.preset));  // the default preset's simulation mesh, ready before any call
+    engine_ = std::make_unique<RegistrationEngine>(btr::load_scene(params_.scene));
+    // The default preset's simulation mesh, model and solvers, ready before any call.
+    const PreparedScene& p = engine_->prepare(preset_options(params_.preset));
+    for (const auto& w : p.warnings) ROS_WARN_STREAM("scene: " << w);
+    const Scene& s = engine_->scene();
+    if (!p.mesh_note.empty()) ROS_INFO("%s for the %s preset (%.2f s)", p.mesh_note.c_str(), params_.preset.c_str(), p.mesh_seconds);
     if (!s.prone_rigid) {
       ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
     } else {
@@ -142,13 +141,12 @@ void RegistrationNode::load_scene() {
                static_cast<long>(tracked_region_->points.rows()), params_.rigid_margin * 1e3);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    ROS_INFO("loaded scene %s: %ld vertices, %ld tetrahedra, %zu tumours in %.2f s", params_.scene.c_str(),
-             static_cast<long>(loaded_->model.rest.V.rows()), static_cast<long>(loaded_->model.rest.T.rows()),
-             loaded_->model.tumours.size(), seconds);
+    ROS_INFO("loaded scene %s: simulating on %ld vertices, %ld tetrahedra, %zu tumours; prepared in %.2f s", params_.scene.c_str(),
+             static_cast<long>(p.model.rest.V.rows()), static_cast<long>(p.model.rest.T.rows()), p.model.tumours.size(),
+             seconds);
     publish_status(diagnostic_msgs::DiagnosticStatus::OK, "scene loaded; waiting for depth clouds");
   } catch (const std::exception& e) {
-    loaded_.reset();
-    simulations_.clear();
+    engine_.reset();
     tracked_region_.reset();
     scene_error_ = e.what();
     ROS_ERROR_STREAM("cannot load the scene: " << scene_error_ << " (the node keeps running; fix ~scene and restart)");
@@ -244,29 +242,6 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
   }
 }
 
-std::shared_ptr<const RegistrationNode::Simulation> RegistrationNode::simulation_for(const RegistrationOptions& opt) {
-  auto it = simulations_.find(opt.simulation_cell_size);
-  if (it != simulations_.end()) return it->second;
-  const auto t0 = std::chrono::steady_clock::now();
-  std::optional<Scene> coarse = simulation_scene(loaded_->scene, opt);
-  std::shared_ptr<const Simulation> sim;
-  if (!coarse) {
-    sim = loaded_;
-  } else {
-    std::vector<std::string> warnings;
-    RegistrationModel m = prepare_model(*coarse, warnings);
-    for (const auto& w : warnings) ROS_WARN_STREAM("simulation mesh: " << w);
-    const Scene& s = *coarse;
-    ROS_INFO("simulation mesh for cell size %.1f mm: %ld tetrahedra (scene: %ld), prepared in %.2f s",
-             opt.simulation_cell_size * 1e3, static_cast<long>(s.prone.T.rows()),
-             static_cast<long>(loaded_->scene.prone.T.rows()),
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    sim = std::make_shared<Simulation>(Simulation{std::move(*coarse), std::move(m)});
-  }
-  simulations_[opt.simulation_cell_size] = sim;
-  return sim;
-}
-
 bool RegistrationNode::on_register(breast_tumour_registration::Register::Request& req,
                                    breast_tumour_registration::Register::Response& res) {
   std::unique_lock<std::mutex> busy(registration_mutex_, std::try_to_lock);
@@ -276,12 +251,11 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     return true;
   }
   try {
-    if (!loaded_) throw InputError("the node is not ready: " + scene_error_ + "; fix it and restart the node");
+    if (!engine_) throw InputError("the node is not ready: " + scene_error_ + "; fix it and restart the node");
     const std::string preset = req.preset.empty() ? params_.preset : req.preset;
-    RegistrationOptions opt = preset_options(preset);
-    const std::shared_ptr<const Simulation> sim = simulation_for(opt);
-    Scene scene = sim->scene;
-    scene.preset = preset;
+    const RegistrationOptions opt = preset_options(preset);
+    std::optional<LiveScan> scan;
+    LiveSceneOptions lo;
     if (req.use_latest_cloud) {
       Points cloud;
       int w, h;
@@ -306,12 +280,9 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       if (tracked < params_.min_tracked_clouds)
         throw NotReady("the depth tracking is settling (" + std::to_string(tracked) + " of " +
                        std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
-      LiveSceneOptions lo;
       lo.max_depth_edge = params_.max_depth_edge;
       lo.use_landmarks = params_.use_landmarks;
-      LiveScene live = live_scene(scene, LiveScan{std::move(cloud), w, h, *T}, lo);
-      scene = std::move(live.scene);
-      opt.known_supine_to_model = live.known_supine_to_model;
+      scan = LiveScan{std::move(cloud), w, h, *T};
     }
     publish_status(diagnostic_msgs::DiagnosticStatus::OK, "registration running (" + preset + ")");
     struct Flag {
@@ -319,8 +290,8 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       explicit Flag(std::atomic<bool>& x) : f(x) { f = true; }
       ~Flag() { f = false; }
     } running(registering_);
-    const RegistrationResult r = run_registration(scene, sim->model, opt);
-    publish_result(r, sim->model, preset, res.result);
+    const RegistrationResult r = scan ? engine_->solve_live(*scan, lo, opt) : engine_->solve(opt);
+    publish_result(r, engine_->prepare(opt).model, preset, res.result);
     res.success = true;
     res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")";
     for (const auto& step : r.reports) {

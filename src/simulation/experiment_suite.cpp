@@ -10,6 +10,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/simulation/experiment_shards.h"
 
@@ -294,7 +295,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           }
           RegistrationOptions ro = preset;
           ro.landmark.weight = run->landmark_weight;
-          const RegistrationResult r = run_registration(scene, rm, ro);
+          RegistrationEngine engine(scene, std::move(rm), std::move(warnings));
+          const RegistrationResult r = engine.solve(ro);
           std::string status = "converged";
           if (!r.converged) {  // which step, and why: a cap, a stall or a failed line search
             status = "not_converged";

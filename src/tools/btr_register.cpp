@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 
 using namespace btr;
@@ -60,25 +61,21 @@ int main(int argc, char** argv) {
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
     RegistrationOptions opt = preset_options(scene.preset);
     if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
-    if (scene.prone_source) {
-      // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh.
-      const double cell = cell_mm > 0 ? cell_mm * 1e-3
-                                       : scene.prone_source->cell_size.value_or(
-                                             opt.simulation_cell_size > 0 ? opt.simulation_cell_size : kDefaultCellSize);
-      mesh_prone(scene, cell);
-      std::printf("[register] tetrahedralized the prone surface at %.1f mm (%.2f s)\n", cell * 1e3, scene.tetrahedralize_seconds);
-    } else if (auto coarse = simulation_scene(scene, opt)) {
-      scene = std::move(*coarse);
-      std::printf("[register] simulating on the prone model re-tetrahedralized at %.1f mm (%.2f s; --cell-size 0 keeps "
-                  "the scene's mesh)\n", opt.simulation_cell_size * 1e3, scene.tetrahedralize_seconds);
-    }
-    const PlannedSteps plan = plan_steps(scene);
-    std::vector<std::string> warnings;
-    const RegistrationModel model = prepare_model(scene, warnings);
+    // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh (the engine meshes once).
+    if (scene.prone_source && cell_mm > 0) scene.prone_source->cell_size = cell_mm * 1e-3;
+    RegistrationEngine engine(std::move(scene));
+    const PreparedScene& prepared = engine.prepare(opt);
+    const Scene& sim = prepared.scene;
+    const RegistrationModel& model = prepared.model;
+    const std::vector<std::string>& warnings = prepared.warnings;
+    if (!prepared.mesh_note.empty())
+      std::printf("[register] %s (%.2f s%s)\n", prepared.mesh_note.c_str(), prepared.mesh_seconds,
+                  sim.prone_source ? "" : "; --cell-size 0 keeps the scene's mesh");
+    const PlannedSteps plan = plan_steps(sim);
     const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("[register] %s: %ld vertices, %ld tetrahedra%s; steps: %s; preset %s\n", scene_path.c_str(),
                 static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows()),
-                scene.tetrahedralized ? " (tetrahedralized)" : "", plan.describe().c_str(), scene.preset.c_str());
+                sim.tetrahedralized ? " (tetrahedralized)" : "", plan.describe().c_str(), opt.preset.c_str());
     if (model.materials.size() > 1) {
       std::string mats;
       for (size_t i = 0; i < model.materials.size(); ++i)
@@ -95,8 +92,7 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         return true;
       };
-    RegistrationResult r = run_registration(scene, model, opt, progress);
-    r.warnings.insert(r.warnings.begin(), warnings.begin(), warnings.end());
+    RegistrationResult r = engine.solve(opt, progress);
     if (tty && !quiet) std::printf("\n");
     if (plan.rigid_landmarks || plan.rigid_icp)
       std::printf("[rigid   ] %.2f deg, %.2f mm (%s) in %.3f s\n", rotation_angle(r.supine_to_model) * 180 / M_PI,
@@ -134,10 +130,10 @@ int main(int argc, char** argv) {
                     t.rigid_centroid_distance * 1e3, t.hausdorff * 1e3);
       std::printf("\n");
     }
-    const auto files = write_registration_outputs(out_dir, scene, model, r, prepare);
+    const auto files = write_registration_outputs(out_dir, sim, model, r, prepare);
     std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "
                 "(report.json, cross_section.png, registered.vtk, ...)\n",
-                r.seconds, scene.tetrahedralize_seconds, prepare, files.size(),
+                r.seconds, prepared.mesh_seconds, prepare, files.size(),
                 std::filesystem::absolute(out_dir).string().c_str());
     if (!r.converged) {
       std::fprintf(stderr, "btr_register: a step stopped without converging (see report.json); try the accurate preset\n");

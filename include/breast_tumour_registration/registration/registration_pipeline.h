@@ -76,6 +76,8 @@ PlannedSteps plan_steps(const Scene& scene);
 /// (with_simulation_mesh); otherwise nullopt (simulate on the scene's mesh). Callers
 /// prepare it once and cache it with its model.
 std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt);
+/// Whether simulation_scene would re-tetrahedralize (without doing it).
+bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt);
 
 /// Builds the registration model of a scene (material, tumours embedded, stiffer tumour if
 /// asked, and the unloaded rest shape when the scene gives prone_gravity: model.unload, whose
@@ -131,7 +133,9 @@ struct RegistrationResult {
 
 /// Runs the planned steps. Throws InputError for inconsistent inputs and SolverError for
 /// numerical failure; a step that stops without converging sets `converged = false`.
+/// cache: the solvers kept for `prepared` between calls (RegistrationEngine does this);
+/// nullptr builds every step's solver for this call. The answer is the same either way.
 RegistrationResult run_registration(const Scene& scene, const RegistrationModel& prepared, const RegistrationOptions& opt,
-                                    const StepCallback& callback = {});
+                                    const StepCallback& callback = {}, StepSolvers* cache = nullptr);
 
 }  // namespace btr

@@ -14,15 +14,13 @@
 
 #include <atomic>
 #include <memory>
-#include <map>
-#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
 
 #include "breast_tumour_registration/Register.h"
 #include "breast_tumour_registration/registration/depth_tracker.h"
-#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
 
 namespace btr {
 
@@ -63,16 +61,10 @@ class RegistrationNode {
 
   ros::NodeHandle nh_, pnh_;
   NodeParameters params_;
-  // The scene as loaded with its model (built once at start-up; null when loading failed)
-  // and, per simulation cell size a preset asks for, the scene and model it simulates on
-  // (built on first use, under registration_mutex_; the loaded one when no remeshing is due).
-  struct Simulation {
-    Scene scene;
-    RegistrationModel model;
-  };
-  std::shared_ptr<const Simulation> loaded_;
-  std::map<double, std::shared_ptr<const Simulation>> simulations_;
-  std::shared_ptr<const Simulation> simulation_for(const RegistrationOptions& opt);
+  // The scene's registration engine (null when loading failed): it prepares, per simulation
+  // mesh a preset asks for, the model and the steps' solvers on first use (the default preset's
+  // at start-up) and keeps them; used under registration_mutex_ only.
+  std::unique_ptr<RegistrationEngine> engine_;
   std::string scene_error_;
   // Latest cloud (working frame, organized with NaN) and the tracked rigid alignment.
   std::mutex state_mutex_;

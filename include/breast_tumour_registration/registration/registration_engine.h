@@ -1,0 +1,79 @@
+// The registration engine: one scene prepared once and registered many times. It owns, per
+// simulation mesh a preset asks for, the prepared prone side (the mesh, tetrahedralized or
+// re-tetrahedralized once; the model with its materials, embedded tumours and rest shape) and
+// the solvers of every step (StepSolvers: Hessian patterns with CHOLMOD's symbolic analysis,
+// the landmark subspace). Every caller registers through it: btr_register, the experiment
+// suite, the benches and the ROS node (with solve_live on the latest depth scan).
+//
+// Not thread-safe: one solve at a time (the node serialises its service calls).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/io/scene.h"
+#include "breast_tumour_registration/registration/live_scene.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/step_solvers.h"
+#include "breast_tumour_registration/registration/unload_step.h"
+
+namespace btr {
+
+/// A scene's prone side prepared for one simulation mesh.
+struct PreparedScene {
+  Scene scene;                        ///< as simulated: the simulation mesh, the supine side as given
+  RegistrationModel model;
+  std::vector<std::string> warnings;  ///< from preparing (tumour points outside the mesh, ...)
+  /// How the simulation mesh was made: "tetrahedralized the prone surface at 7.0 mm",
+  /// "re-tetrahedralized at 7.0 mm", or empty (the scene's mesh as given).
+  std::string mesh_note;
+  double mesh_seconds = 0;      ///< tetrahedralization [s]
+  double prepare_seconds = 0;   ///< meshing and model preparation [s]
+};
+
+class RegistrationEngine {
+ public:
+  /// The scene as loaded (a prone surface may still be unmeshed: load_scene with
+  /// tetrahedralize = false); nothing is prepared until the first call asks for a mesh.
+  explicit RegistrationEngine(Scene scene, UnloadOptions unload = {});
+  /// Adopts a model already prepared for `simulated` (e.g. the experiment suite's, whose
+  /// unloaded shape is shared between runs); every call simulates on it, whatever the preset's mesh.
+  RegistrationEngine(Scene simulated, RegistrationModel model, std::vector<std::string> warnings = {});
+
+  /// The prone side for opt's simulation mesh: a prone surface is tetrahedralized at its
+  /// prone.cell_size_mm, else the preset's size; a finer scene mesh is re-tetrahedralized at the
+  /// preset's size (simulation_scene); the model is prepared. Done on first use and kept.
+  /// InputError / SolverError as load_scene, mesh_prone and prepare_model.
+  const PreparedScene& prepare(const RegistrationOptions& opt);
+
+  /// Registers the scene's own supine side. The result's warnings start with the preparation's.
+  RegistrationResult solve(const RegistrationOptions& opt, const StepCallback& callback = {});
+  /// Registers `supine` (this engine's scene, or a copy whose supine side, landmarks' supine
+  /// positions, ground truth or steps were replaced) on the prepared prone side; InputError when
+  /// its prone side is not this engine's (another vertex or landmark count).
+  RegistrationResult solve(const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback = {});
+  /// Registers a live depth scan (live_scene): the tracked pose decides the rigid alignment.
+  RegistrationResult solve_live(const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions opt,
+                                const StepCallback& callback = {});
+
+  const Scene& scene() const { return scene_; }  ///< as given
+  int solvers_built() const;   ///< over every prepared mesh
+  int solvers_reused() const;
+
+ private:
+  struct Entry {
+    PreparedScene prepared;
+    StepSolvers solvers;
+  };
+  Entry& entry(const RegistrationOptions& opt);
+  RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);
+
+  Scene scene_;
+  UnloadOptions unload_;
+  bool adopted_ = false;                           ///< one entry for every call
+  std::map<double, std::unique_ptr<Entry>> entries_;  ///< by simulation cell size [m]
+};
+
+}  // namespace btr
