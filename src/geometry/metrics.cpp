@@ -29,6 +29,26 @@ Vec3 volume_centroid(const SurfaceMesh& s) {
   return c / vol;
 }
 
+Eigen::MatrixXd volume_centroid_jacobian(const SurfaceMesh& s) {
+  // c = M / V with V = sum_f V_f, M = sum_f V_f S_f / 4, V_f = a.(b x d) / 6, S_f = a + b + d:
+  // dc/dp = (dM/dp - c dV/dp) / V, dV_f/da = (b x d) / 6 (cyclic), dS_f/da = I.
+  const Vec3 c = volume_centroid(s);
+  const double vol = enclosed_volume(s);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3, 3 * s.V.rows());
+  for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
+    const int idx[3] = {s.F(f, 0), s.F(f, 1), s.F(f, 2)};
+    const Vec3 p[3] = {s.V.row(idx[0]), s.V.row(idx[1]), s.V.row(idx[2])};
+    const double vf = p[0].dot(p[1].cross(p[2])) / 6.0;
+    const Vec3 S = p[0] + p[1] + p[2];
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 dv = p[(i + 1) % 3].cross(p[(i + 2) % 3]) / 6.0;  // dV_f / dp_i
+      // dM/dp_i = (S - 4 c) dv^T / 4 + V_f / 4 I (the -c dV/dp term folded in)
+      J.middleCols<3>(3 * idx[i]) += ((S / 4.0 - c) * dv.transpose() + (vf / 4.0) * Mat3::Identity()) / vol;
+    }
+  }
+  return J;
+}
+
 double principal_axis_ratio(const SurfaceMesh& s) {
   // Second moment of the volume by summing signed tetrahedra (origin, a, b, c):
   // int x x^T dV = V/20 (sum_i p_i p_i^T + S S^T), S = sum_i p_i (origin contributes 0).

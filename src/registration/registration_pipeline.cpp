@@ -367,6 +367,21 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     }
     r.tumours.push_back(tr);
   }
+  if (opt.uncertainty.enabled) {
+    if (!r.steps.surface || !supine) {
+      r.uncertainty_note = "not computed: it linearises the surface step's equilibrium, and the surface step did not run";
+    } else {
+      const UncertaintyResult u =
+          linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, opt.surface, opt.uncertainty);
+      for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
+      r.uncertainty_seconds = u.seconds;
+      std::vector<std::string> notes;
+      if (!u.note.empty()) notes.push_back(u.note);
+      if (r.pose_solved_with_surface) notes.push_back("the rigid pose is held at its solution");
+      if (!r.converged) notes.push_back("linearised at a state that is not converged");
+      for (const auto& n : notes) r.uncertainty_note += (r.uncertainty_note.empty() ? "" : "; ") + n;
+    }
+  }
   if (targets.rows()) {
     std::vector<double> d;
     for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)

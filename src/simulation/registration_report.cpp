@@ -1,5 +1,6 @@
 #include "breast_tumour_registration/simulation/registration_report.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -117,9 +118,25 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
         << ", \"volume_ratio_to_truth\": " << num(t.volume_ratio_to_truth)
         << ", \"truth_axis_ratio\": " << num(t.truth_axis_ratio)
         << ", \"rigid_only_centroid_distance_mm\": " << num(t.rigid_centroid_distance * 1e3);
+    if (t.uncertainty) {
+      const TumourUncertainty& u = *t.uncertainty;
+      j << ",\n     \"uncertainty\": {\"method\": \"linear\", \"radius_95_mm\": " << num(u.radius_95 * 1e3)
+        << ", \"covariance_mm2\": [";
+      for (int a = 0; a < 3; ++a)
+        j << (a ? ", " : "") << "[" << num(u.covariance(a, 0) * 1e6) << ", " << num(u.covariance(a, 1) * 1e6) << ", "
+          << num(u.covariance(a, 2) * 1e6) << "]";
+      j << "], \"rms_mm_by_source\": {";
+      for (size_t k = 0; k < u.sources.size(); ++k)
+        j << (k ? ", " : "") << quote(u.sources[k].first) << ": " << num(std::sqrt(std::max(0.0, u.sources[k].second.trace())) * 1e3);
+      j << "}, \"d_centroid_d_ln_youngs_modulus_mm\": " << vec_mm(u.d_log_youngs_modulus) << "}";
+    }
     j << "}";
   }
-  j << "\n  ],\n  \"landmark_residual_mm\": {\"mean\": " << num(r.landmark_residual_mean * 1e3)
+  j << "\n  ],\n";
+  if (!r.uncertainty_note.empty() || (!r.tumours.empty() && r.tumours[0].uncertainty))
+    j << "  \"uncertainty\": {\"method\": \"linear\", \"validated\": false, \"seconds\": " << num(r.uncertainty_seconds)
+      << ", \"note\": " << quote(r.uncertainty_note) << "},\n";
+  j << "  \"landmark_residual_mm\": {\"mean\": " << num(r.landmark_residual_mean * 1e3)
     << ", \"max\": " << num(r.landmark_residual_max * 1e3) << "},\n  \"skin_to_supine_surface_mm\": {\"mean\": "
     << num(r.skin_distance_mean * 1e3) << ", \"max\": " << num(r.skin_distance_max * 1e3) << "},\n  \"warnings\": [";
   for (size_t i = 0; i < r.warnings.size(); ++i) j << (i ? ", " : "") << quote(r.warnings[i]);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
       "Exit codes: 0 converged, 2 invalid input, 3 numerical failure, 4 finished without converging (outputs written),\n"
       "5 converged but implausible: a landmark or the skin ends far from its data, or the rigid pose was undecided\n"
       "(outputs written; the warnings say which)."};
-  std::string scene_path, out_dir = "registration", preset, steps;
+  std::string scene_path, out_dir = "registration", preset, steps, uncertainty = "none";
   double tumour_E = 0, cell_mm = -1;
   bool quiet = false;
   app.add_option("scene", scene_path, "scene file (YAML), e.g. written by btr_phantom")->required();
@@ -37,6 +38,11 @@ int main(int argc, char** argv) {
                  "simulate on the prone model (re-)tetrahedralized at this cell size [mm] (default: a prone surface's "
                  "prone.cell_size_mm, else the preset's; 0: the scene's mesh as given)")
       ->check(btr::cli::non_negative());
+  app.add_option("--uncertainty", uncertainty,
+                 "none, or linear (experimental, not yet validated): each tumour centroid's covariance and 95 % radius "
+                 "from the Young's modulus, the gravity direction and the depth noise (tumour_uncertainty.h)")
+      ->check(CLI::IsMember({"none", "linear"}))
+      ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no progress display");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
@@ -61,6 +67,7 @@ int main(int argc, char** argv) {
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
     RegistrationOptions opt = preset_options(scene.preset);
     if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
+    opt.uncertainty.enabled = uncertainty == "linear";
     // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh (the engine meshes once).
     if (scene.prone_source && cell_mm > 0) scene.prone_source->cell_size = cell_mm * 1e-3;
     RegistrationEngine engine(std::move(scene));
@@ -129,7 +136,18 @@ int main(int argc, char** argv) {
         std::printf(", centroid error %.3f mm (rigid only %.2f mm), Hausdorff %.2f mm", t.centroid_distance * 1e3,
                     t.rigid_centroid_distance * 1e3, t.hausdorff * 1e3);
       std::printf("\n");
+      if (t.uncertainty) {
+        const TumourUncertainty& u = *t.uncertainty;
+        std::printf("[uncert  ] %-8s 95 %% radius %.2f mm (rms by source:", t.name.c_str(), u.radius_95 * 1e3);
+        for (const auto& [name, cov] : u.sources) std::printf(" %s %.2f", name.c_str(), std::sqrt(std::max(0.0, cov.trace())) * 1e3);
+        std::printf(" mm)%s\n", t.has_ground_truth ? (t.centroid_distance <= u.radius_95 ? "; holds the true centroid"
+                                                                                      : "; the true centroid lies outside")
+                                                     : "");
+      }
     }
+    if (opt.uncertainty.enabled)
+      std::printf("[uncert  ] linearised in %.3f s%s%s\n", r.uncertainty_seconds, r.uncertainty_note.empty() ? "" : ": ",
+                  r.uncertainty_note.c_str());
     const auto files = write_registration_outputs(out_dir, sim, model, r, prepare);
     std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "
                 "(report.json, cross_section.png, registered.vtk, ...)\n",

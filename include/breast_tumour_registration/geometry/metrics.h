@@ -12,6 +12,8 @@ namespace btr {
 double enclosed_volume(const SurfaceMesh& s);
 /// Volume centroid of a closed surface: independent of how the surface is sampled.
 Vec3 volume_centroid(const SurfaceMesh& s);
+/// d volume_centroid / d s.V: 3 by 3#V, column 3 v + k the derivative by coordinate k of vertex v.
+Eigen::MatrixXd volume_centroid_jacobian(const SurfaceMesh& s);
 /// Shape of a closed surface's volume: sqrt(smallest / largest eigenvalue of its second
 /// moment), i.e. shortest over longest principal axis; 1 for a sphere, < 1 when flattened.
 double principal_axis_ratio(const SurfaceMesh& s);

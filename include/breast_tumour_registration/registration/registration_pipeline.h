@@ -13,6 +13,7 @@
 #include "breast_tumour_registration/registration/rigid_regions.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/registration/surface_step.h"
+#include "breast_tumour_registration/registration/tumour_uncertainty.h"
 #include "breast_tumour_registration/registration/unload_step.h"
 
 namespace btr {
@@ -45,6 +46,8 @@ struct RegistrationOptions {
   double landmark_residual_fraction = 0.02;
   double skin_distance_bound = 0.002;          ///< [m]
   double skin_distance_fraction = 0.01;
+  /// The tumours' linearised uncertainty (tumour_uncertainty.h), when enabled and the surface step ran.
+  UncertaintyOptions uncertainty;
 };
 
 /// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
@@ -99,6 +102,7 @@ struct TumourResult {
   double volume_ratio_to_truth = 0;
   double truth_axis_ratio = 0;
   double rigid_centroid_distance = 0;  ///< [m] prone tumour (rigidly aligned) to ground truth
+  std::optional<TumourUncertainty> uncertainty;  ///< when asked for (RegistrationOptions::uncertainty)
 };
 
 struct RegistrationResult {
@@ -129,6 +133,8 @@ struct RegistrationResult {
   /// the rigid pose was left undecided; `warnings` says which. btr_register exits with 5.
   bool implausible = false;
   std::vector<std::string> warnings;
+  std::string uncertainty_note;    ///< what the uncertainty assumed, or why it was not computed
+  double uncertainty_seconds = 0;  ///< its cost, not in `seconds`
 };
 
 /// Runs the planned steps. Throws InputError for inconsistent inputs and SolverError for

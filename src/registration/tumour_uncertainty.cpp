@@ -1,0 +1,175 @@
+#include "breast_tumour_registration/registration/tumour_uncertainty.h"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Eigenvalues>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/fem/hessian_pattern.h"
+#include "breast_tumour_registration/fem/plane_constraint_energy.h"
+#include "breast_tumour_registration/fem/total_energy.h"
+#include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/metrics.h"
+
+namespace btr {
+namespace {
+
+void check(double v, const char* field) {
+  if (!std::isfinite(v) || v < 0)
+    throw InputError(std::string("uncertainty: field '") + field + "' must be finite and >= 0, got " + std::to_string(v));
+}
+
+/// P(sum_i l_i z_i^2 <= r^2) for independent standard normal z, l sorted ascending.
+double chi_square_mixture_cdf(const Vec3& l, double r) {
+  if (l(2) <= 0) return r >= 0 ? 1.0 : 0.0;
+  // Integrate P(z3^2 <= (r^2 - l1 z1^2 - l2 z2^2) / l3) over z1, z2 >= 0 (even integrand):
+  // midpoint rule on [0, 8] with the normal density, folded.
+  constexpr int n = 160;
+  constexpr double top = 8.0;
+  // Each integral runs to where its integrand's support ends (midpoint rule on that interval).
+  auto limit = [&](double a, double l) { return l > 0 ? std::min(top, std::sqrt(std::max(0.0, a) / l)) : top; };
+  auto normal = [](double z) { return std::exp(-0.5 * z * z) / std::sqrt(2.0 * M_PI); };
+  double p = 0;
+  const double u1 = limit(r * r, l(0)), h1 = u1 / n;
+  for (int i = 0; i < n; ++i) {
+    const double z1 = (i + 0.5) * h1, a = r * r - l(0) * z1 * z1;
+    if (a <= 0) continue;
+    const double u2 = limit(a, l(1)), h2 = u2 / n;
+    double inner = 0;
+    for (int j = 0; j < n; ++j) {
+      const double z2 = (j + 0.5) * h2, b = a - l(1) * z2 * z2;
+      if (b > 0) inner += 2.0 * h2 * normal(z2) * std::erf(std::sqrt(b / (2.0 * l(2))));
+    }
+    p += 2.0 * h1 * normal(z1) * inner;
+  }
+  return p;
+}
+
+}  // namespace
+
+void validate_uncertainty_options(const UncertaintyOptions& o) {
+  check(o.youngs_modulus_log_sd, "youngs_modulus_log_sd");
+  check(o.gravity_direction_deg, "gravity_direction_deg");
+  check(o.depth_noise, "depth_noise_mm");
+}
+
+double radius_95(const Mat3& covariance) {
+  Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (covariance + covariance.transpose()));
+  Vec3 l = es.eigenvalues().cwiseMax(0.0);  // ascending
+  if (l(2) <= 0) return 0;
+  // Bracket: at least the largest axis' 1-D radius (1.96 sd); at most that of all the variance
+  // on one axis (the 95 % quantile of a weighted sum of chi-square(1) is largest with one term).
+  double lo = 1.959 * std::sqrt(l(2)), hi = 1.961 * std::sqrt(l.sum());
+  for (int it = 0; it < 50 && hi - lo > 1e-6 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (chi_square_mixture_cdf(l, mid) < 0.95 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
+                                                const SurfaceProjector& supine, const Rigid& model_to_projector,
+                                                const Rigid& model_to_supine, const SurfaceStepOptions& surface,
+                                                const UncertaintyOptions& opt) {
+  validate_uncertainty_options(opt);
+  const auto t0 = std::chrono::steady_clock::now();
+  UncertaintyResult out;
+  const int nv = static_cast<int>(x.rows());
+
+  // The fixed point's Jacobian: elastic + held skin along its normals.
+  TotalEnergy elastic;
+  add_model_elastic_energy(elastic, model);
+  const double spring = surface.point_weight + surface.plane_weight;
+  auto planes = std::make_shared<PlaneConstraintEnergy>(spring);
+  std::vector<int> held;
+  std::vector<Vec3> held_normal;  // model frame
+  const Mat3 R_p = model_to_projector.linear();
+  for (int v : model.skin) {
+    const Projection c = supine.project(model_to_projector * Vec3(x.row(v).transpose()));
+    if (surface.max_projection_distance > 0 && c.distance > surface.max_projection_distance) continue;
+    if (surface.reject_boundary && c.on_boundary) continue;
+    const Vec3 n = R_p.transpose() * c.normal;
+    planes->add(Anchor::vertex(v), model_to_projector.inverse() * c.point, n);
+    held.push_back(v);
+    held_normal.push_back(n.normalized());
+  }
+  if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
+  TotalEnergy jac;
+  for (const auto& t : elastic.terms()) jac.add(t);
+  jac.add(planes);
+  HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  llt.cholmod().print = 0;
+  jac.hessian(x, false, H);
+  llt.compute(H.matrix());
+  if (llt.info() != Eigen::Success) {
+    // An element compressed past its stable range makes the exact Hessian indefinite there;
+    // the projected one is a bound on the stiffness, so the spread it gives is a lower bound.
+    out.note = "the exact Hessian is not positive definite at the result; linearised on the projected one (a lower bound)";
+    jac.hessian(x, true, H);
+    llt.compute(H.matrix());
+    if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the fixed point's Jacobian cannot be factorized");
+  }
+
+  // Inputs' dG/dp on the free DOFs.
+  const Eigen::VectorXd b_E = H.gather(elastic.gradient(x));  // G_elastic is linear in E: dG/d ln E = G_elastic
+  Eigen::VectorXd b_g[2];
+  Vec3 axes[2] = {Vec3::Zero(), Vec3::Zero()};
+  const bool gravity = surface.gravity && model.gravity.norm() > 0;
+  if (gravity) {
+    const GravityEnergy g(model.rest, model.material.density, model.gravity);
+    const Vec3 down = model.gravity.normalized();
+    axes[0] = down.unitOrthogonal();
+    axes[1] = down.cross(axes[0]);
+    for (int k = 0; k < 2; ++k) {
+      const Vec3 dg = axes[k].cross(model.gravity);  // a tilt by d theta about axes[k]
+      Eigen::VectorXd full(3 * nv);
+      for (int v = 0; v < nv; ++v) full.segment<3>(3 * v) = -g.masses()(v) * dg;
+      b_g[k] = H.gather(full);
+    }
+  }
+  const Mat3 R_s = model_to_supine.linear();
+  const double sd_theta = opt.gravity_direction_deg * M_PI / 180.0;
+  for (const auto& mt : model.tumours) {
+    const SurfaceMesh s{apply_embedding(mt.embedding, model.rest.T, x), mt.prone.F};
+    const Eigen::MatrixXd Jp = volume_centroid_jacobian(s);  // 3 x 3#P, model frame
+    Eigen::MatrixXd Jx = Eigen::MatrixXd::Zero(3 * nv, 3);   // (dc/dx)^T
+    for (Eigen::Index p = 0; p < s.V.rows(); ++p) {
+      const int t = mt.embedding.tet(p);
+      for (int k = 0; k < 4; ++k)
+        Jx.middleRows<3>(3 * model.rest.T(t, k)) += mt.embedding.weights(p, k) * Jp.middleCols<3>(3 * p).transpose();
+    }
+    Eigen::MatrixXd R(H.num_free_dofs(), 3);
+    for (int k = 0; k < 3; ++k) R.col(k) = H.gather(Jx.col(k));
+    const Eigen::MatrixXd lambda = llt.solve(R);  // free DOFs x 3
+    TumourUncertainty u;
+    u.d_log_youngs_modulus = R_s * Vec3(-lambda.transpose() * b_E);
+    Mat3 cov_E = opt.youngs_modulus_log_sd * opt.youngs_modulus_log_sd * u.d_log_youngs_modulus *
+                 u.d_log_youngs_modulus.transpose();
+    Mat3 cov_g = Mat3::Zero();
+    if (gravity)
+      for (int k = 0; k < 2; ++k) {
+        u.d_gravity_tilt[k] = R_s * Vec3(-lambda.transpose() * b_g[k]);
+        cov_g += sd_theta * sd_theta * u.d_gravity_tilt[k] * u.d_gravity_tilt[k].transpose();
+      }
+    // Depth noise: the held target of vertex v moves by delta along n, dG_v/d delta = -spring n.
+    Mat3 cov_d = Mat3::Zero();
+    for (size_t i = 0; i < held.size(); ++i) {
+      const int f = H.free_index(held[i]);
+      if (f < 0) continue;
+      const Vec3 d = R_s * Vec3(spring * lambda.middleRows<3>(3 * f).transpose() * held_normal[i]);
+      cov_d += opt.depth_noise * opt.depth_noise * d * d.transpose();
+    }
+    u.covariance = cov_E + cov_g + cov_d;
+    u.sources = {{"youngs_modulus", cov_E}, {"gravity_direction", cov_g}, {"depth_noise", cov_d}};
+    u.radius_95 = radius_95(u.covariance);
+    out.tumours.push_back(u);
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace btr
