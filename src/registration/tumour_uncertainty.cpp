@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/plane_constraint_energy.h"
+#include "breast_tumour_registration/fem/point_constraint_energy.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
@@ -74,6 +75,21 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
                                                 const UncertaintyOptions& opt) {
+  std::vector<HeldSkinVertex> held;
+  const Mat3 R_p = model_to_projector.linear();
+  const Rigid to_model = model_to_projector.inverse();
+  for (int v : model.skin) {
+    const Projection c = supine.project(model_to_projector * Vec3(x.row(v).transpose()));
+    if (surface.max_projection_distance > 0 && c.distance > surface.max_projection_distance) continue;
+    if (surface.reject_boundary && c.on_boundary) continue;
+    held.push_back({v, to_model * c.point, (R_p.transpose() * c.normal).normalized()});
+  }
+  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt);
+}
+
+UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
+                                                const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
+                                                const SurfaceStepOptions& surface, const UncertaintyOptions& opt) {
   validate_uncertainty_options(opt);
   const auto t0 = std::chrono::steady_clock::now();
   UncertaintyResult out;
@@ -82,24 +98,19 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // The fixed point's Jacobian: elastic + held skin along its normals.
   TotalEnergy elastic;
   add_model_elastic_energy(elastic, model);
+  // A held target moving by delta along n moves both springs' targets: dG/d delta = -spring n.
   const double spring = surface.point_weight + surface.plane_weight;
-  auto planes = std::make_shared<PlaneConstraintEnergy>(spring);
-  std::vector<int> held;
-  std::vector<Vec3> held_normal;  // model frame
-  const Mat3 R_p = model_to_projector.linear();
-  for (int v : model.skin) {
-    const Projection c = supine.project(model_to_projector * Vec3(x.row(v).transpose()));
-    if (surface.max_projection_distance > 0 && c.distance > surface.max_projection_distance) continue;
-    if (surface.reject_boundary && c.on_boundary) continue;
-    const Vec3 n = R_p.transpose() * c.normal;
-    planes->add(Anchor::vertex(v), model_to_projector.inverse() * c.point, n);
-    held.push_back(v);
-    held_normal.push_back(n.normalized());
+  auto planes = std::make_shared<PlaneConstraintEnergy>(opt.held_projections ? surface.plane_weight : spring);
+  auto points = std::make_shared<PointConstraintEnergy>(surface.point_weight);
+  for (const HeldSkinVertex& h : held) {
+    planes->add(Anchor::vertex(h.vertex), h.point, h.normal);
+    points->add(Anchor::vertex(h.vertex), h.point);
   }
   if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
   TotalEnergy jac;
   for (const auto& t : elastic.terms()) jac.add(t);
   jac.add(planes);
+  if (opt.held_projections) jac.add(points);
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   llt.cholmod().print = 0;
@@ -157,10 +168,10 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       }
     // Depth noise: the held target of vertex v moves by delta along n, dG_v/d delta = -spring n.
     Mat3 cov_d = Mat3::Zero();
-    for (size_t i = 0; i < held.size(); ++i) {
-      const int f = H.free_index(held[i]);
+    for (const HeldSkinVertex& h : held) {
+      const int f = H.free_index(h.vertex);
       if (f < 0) continue;
-      const Vec3 d = R_s * Vec3(spring * lambda.middleRows<3>(3 * f).transpose() * held_normal[i]);
+      const Vec3 d = R_s * Vec3(spring * lambda.middleRows<3>(3 * f).transpose() * h.normal);
       cov_d += opt.depth_noise * opt.depth_noise * d * d.transpose();
     }
     u.covariance = cov_E + cov_g + cov_d;
