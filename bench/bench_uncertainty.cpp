@@ -31,6 +31,10 @@ int main(int argc, char** argv) {
   app.add_option("--max-projections", max_projections, "surface step cap")->capture_default_str();
   app.add_option("--preset", preset, "re-solve with this preset's own tolerances (default: accurate, tightened)");
   app.add_flag("--held", held, "linearise with the projections held");
+  int sampling = 0;
+  app.add_option("--sampling", sampling,
+                 "instead of finite differences: N re-registrations per source (each alone, then all), linear against "
+                 "sampled 95 % radius (with --preset)");
   CLI11_PARSE(app, argc, argv);
   try {
     Scene scene = load_scene(scene_path);
@@ -69,6 +73,40 @@ int main(int argc, char** argv) {
     const RegistrationResult r = solve(scene, true);
     std::printf("  linearisation %.3f s of a %.3f s registration (%.0f %%)\n", r.uncertainty_seconds, r.seconds,
                 100 * r.uncertainty_seconds / r.seconds);
+    if (sampling > 0) {
+      RegistrationEngine engine(scene);
+      const UncertaintyOptions all = o.uncertainty;
+      struct Source {
+        const char* name;
+        UncertaintyOptions u;
+      };
+      std::vector<Source> sources(4, {"", all});
+      sources[0].name = "youngs_modulus";
+      sources[0].u.gravity_direction_deg = sources[0].u.depth_noise = 0;
+      sources[1].name = "gravity_direction";
+      sources[1].u.youngs_modulus_log_sd = sources[1].u.depth_noise = 0;
+      sources[2].name = "depth_noise";
+      sources[2].u.youngs_modulus_log_sd = sources[2].u.gravity_direction_deg = 0;
+      sources[3].name = "all";
+      for (Source& src : sources) {
+        RegistrationOptions oo = o;
+        oo.uncertainty = src.u;
+        oo.uncertainty.enabled = true;
+        const RegistrationResult nominal = engine.solve(oo);
+        const SampledUncertainty su = engine.sample_uncertainty(oo, src.u, sampling, 7, nominal);
+        std::printf("source %-17s %d samples (%d not converged), %.2f s each%s%s\n", src.name, su.samples, su.not_converged,
+                    su.seconds_per_sample, su.note.empty() ? "" : "; ", su.note.c_str());
+        for (size_t i = 0; i < nominal.tumours.size(); ++i) {
+          const double lin = nominal.tumours[i].uncertainty->radius_95, smp = su.tumours[i].radius_95;
+          std::printf("  %-8s 95 %% radius linear %.3f mm, sampled %.3f mm (linear / sampled %.2f); rms linear %.3f, sampled %.3f mm; "
+                      "mean shift %.3f mm\n",
+                      nominal.tumours[i].name.c_str(), 1e3 * lin, 1e3 * smp, lin / smp,
+                      1e3 * std::sqrt(nominal.tumours[i].uncertainty->covariance.trace()),
+                      1e3 * std::sqrt(su.tumours[i].covariance.trace()), 1e3 * su.tumours[i].mean_shift.norm());
+        }
+      }
+      return 0;
+    }
     const Vec3 axis = scene.gravity.normalized().unitOrthogonal();
     for (double h : {0.05, 0.2}) {
       Scene up = scene, down = scene, tp = scene, tm = scene;

@@ -3,9 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
+#include "breast_tumour_registration/registration/stiffness_step.h"
 
 namespace btr {
 namespace {
@@ -119,6 +122,74 @@ RegistrationResult RegistrationEngine::solve_live(const LiveScan& scan, const Li
   ls.scene.preset = opt.preset;
   opt.known_supine_to_model = ls.known_supine_to_model;
   return run(e, ls.scene, opt, callback);
+}
+
+SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources,
+                                                         int samples, unsigned seed, const RegistrationResult& nominal) {
+  validate_uncertainty_options(sources);
+  if (samples < 2) throw InputError("uncertainty sampling: at least 2 samples, got " + std::to_string(samples));
+  Entry& e = entry(opt);
+  const RegistrationModel& model = e.prepared.model;
+  if (nominal.tumours.size() != model.tumours.size())
+    throw InputError("uncertainty sampling: the nominal result has another tumour count than the prepared model");
+  SampledUncertainty out;
+  std::vector<std::string> notes;
+  const bool sample_e = sources.youngs_modulus_log_sd > 0 && !model.unload;
+  if (sources.youngs_modulus_log_sd > 0 && model.unload)
+    notes.push_back("E not sampled: the unloaded rest shape depends on it (one unload per sample is not done)");
+  const bool sample_noise = sources.depth_noise > 0 && e.prepared.scene.supine_surface;
+  if (sources.depth_noise > 0 && !e.prepared.scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
+  Points normals;
+  if (sample_noise) normals = vertex_normals(*e.prepared.scene.supine_surface);
+  const Vec3 down = model.gravity.normalized();
+  const Vec3 axes[2] = {down.unitOrthogonal(), down.cross(down.unitOrthogonal())};
+  RegistrationOptions o = opt;
+  o.uncertainty.enabled = false;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> z(0.0, 1.0);
+  std::vector<std::vector<Vec3>> centroids(model.tumours.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 0; k < samples; ++k) {
+    // Every draw is made whether or not its source is used, so a seed gives the same inputs.
+    const double log_e = sources.youngs_modulus_log_sd * z(rng);
+    const double tilt[2] = {sources.gravity_direction_deg * M_PI / 180 * z(rng), sources.gravity_direction_deg * M_PI / 180 * z(rng)};
+    RegistrationModel m = model;
+    if (sample_e) scale_stiffness(m, std::exp(log_e));
+    m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
+    Scene s = e.prepared.scene;
+    s.preset = opt.preset;
+    if (sample_noise)
+      for (Eigen::Index v = 0; v < s.supine_surface->V.rows(); ++v)
+        s.supine_surface->V.row(v) += sources.depth_noise * z(rng) * normals.row(v);
+    try {
+      const RegistrationResult r = run_registration(s, m, o, {}, &e.solvers);
+      ++out.samples;
+      if (!r.converged) ++out.not_converged;
+      for (size_t i = 0; i < r.tumours.size(); ++i) centroids[i].push_back(r.tumours[i].centroid);
+    } catch (const std::exception&) {
+      ++out.failed;
+    }
+  }
+  out.seconds_per_sample = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / samples;
+  for (size_t i = 0; i < centroids.size(); ++i) {
+    SampledUncertainty::Tumour t;
+    const auto& c = centroids[i];
+    if (c.size() >= 2) {
+      Vec3 mean = Vec3::Zero();
+      for (const Vec3& p : c) mean += p / static_cast<double>(c.size());
+      std::vector<double> d;
+      for (const Vec3& p : c) {
+        t.covariance += (p - mean) * (p - mean).transpose() / static_cast<double>(c.size() - 1);
+        d.push_back((p - nominal.tumours[i].centroid).norm());
+      }
+      t.mean_shift = mean - nominal.tumours[i].centroid;
+      t.radius_95 = percentile_95(d);
+    }
+    out.tumours.push_back(t);
+  }
+  if (out.failed) notes.push_back(std::to_string(out.failed) + " samples failed and are left out");
+  for (const auto& n : notes) out.note += (out.note.empty() ? "" : "; ") + n;
+  return out;
 }
 
 int RegistrationEngine::solvers_built() const {

@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -55,6 +56,13 @@ void validate_uncertainty_options(const UncertaintyOptions& o) {
   check(o.youngs_modulus_log_sd, "youngs_modulus_log_sd");
   check(o.gravity_direction_deg, "gravity_direction_deg");
   check(o.depth_noise, "depth_noise_mm");
+}
+
+double percentile_95(std::vector<double> d) {
+  if (d.empty()) return 0;
+  std::sort(d.begin(), d.end());
+  const size_t rank = static_cast<size_t>(std::ceil(0.95 * static_cast<double>(d.size())));
+  return d[std::max<size_t>(rank, 1) - 1];
 }
 
 double radius_95(const Mat3& covariance) {

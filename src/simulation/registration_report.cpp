@@ -130,12 +130,25 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
         j << (k ? ", " : "") << quote(u.sources[k].first) << ": " << num(std::sqrt(std::max(0.0, u.sources[k].second.trace())) * 1e3);
       j << "}, \"d_centroid_d_ln_youngs_modulus_mm\": " << vec_mm(u.d_log_youngs_modulus) << "}";
     }
+    if (r.sampled_uncertainty && i < r.sampled_uncertainty->tumours.size()) {
+      const auto& u = r.sampled_uncertainty->tumours[i];
+      j << ",\n     \"uncertainty_sampled\": {\"radius_95_mm\": " << num(u.radius_95 * 1e3) << ", \"covariance_mm2\": [";
+      for (int a = 0; a < 3; ++a)
+        j << (a ? ", " : "") << "[" << num(u.covariance(a, 0) * 1e6) << ", " << num(u.covariance(a, 1) * 1e6) << ", "
+          << num(u.covariance(a, 2) * 1e6) << "]";
+      j << "], \"mean_shift_mm\": " << vec_mm(u.mean_shift) << "}";
+    }
     j << "}";
   }
   j << "\n  ],\n";
   if (!r.uncertainty_note.empty() || (!r.tumours.empty() && r.tumours[0].uncertainty))
     j << "  \"uncertainty\": {\"method\": \"linear\", \"validated\": false, \"seconds\": " << num(r.uncertainty_seconds)
       << ", \"note\": " << quote(r.uncertainty_note) << "},\n";
+  if (r.sampled_uncertainty)
+    j << "  \"uncertainty_sampled\": {\"samples\": " << r.sampled_uncertainty->samples
+      << ", \"not_converged\": " << r.sampled_uncertainty->not_converged << ", \"failed\": " << r.sampled_uncertainty->failed
+      << ", \"seconds_per_sample\": " << num(r.sampled_uncertainty->seconds_per_sample)
+      << ", \"note\": " << quote(r.sampled_uncertainty->note) << "},\n";
   j << "  \"landmark_residual_mm\": {\"mean\": " << num(r.landmark_residual_mean * 1e3)
     << ", \"max\": " << num(r.landmark_residual_max * 1e3) << "},\n  \"skin_to_supine_surface_mm\": {\"mean\": "
     << num(r.skin_distance_mean * 1e3) << ", \"max\": " << num(r.skin_distance_max * 1e3) << "},\n  \"warnings\": [";

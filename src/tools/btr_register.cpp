@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
       "5 converged but implausible: a landmark or the skin ends far from its data, or the rigid pose was undecided\n"
       "(outputs written; the warnings say which)."};
   std::string scene_path, out_dir = "registration", preset, steps, uncertainty = "none";
+  int samples = 32;
+  unsigned seed = 1;
   double tumour_E = 0, cell_mm = -1;
   bool quiet = false;
   app.add_option("scene", scene_path, "scene file (YAML), e.g. written by btr_phantom")->required();
@@ -39,10 +41,16 @@ int main(int argc, char** argv) {
                  "prone.cell_size_mm, else the preset's; 0: the scene's mesh as given)")
       ->check(btr::cli::non_negative());
   app.add_option("--uncertainty", uncertainty,
-                 "none, or linear (experimental, not yet validated): each tumour centroid's covariance and 95 % radius "
-                 "from the Young's modulus, the gravity direction and the depth noise (tumour_uncertainty.h)")
-      ->check(CLI::IsMember({"none", "linear"}))
+                 "none; linear (experimental, not yet validated): each tumour centroid's covariance and 95 % radius "
+                 "from the Young's modulus, the gravity direction and the depth noise (tumour_uncertainty.h); sampling: "
+                 "the same from re-registrations with sampled inputs, beside the linear figures")
+      ->check(CLI::IsMember({"none", "linear", "sampling"}))
       ->capture_default_str();
+  app.add_option("--samples", samples, "with --uncertainty sampling: re-registrations with sampled inputs (the linear "
+                                       "figures are computed too, for comparison)")
+      ->check(CLI::Range(2, 100000))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "with --uncertainty sampling: random seed")->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no progress display");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
@@ -67,7 +75,7 @@ int main(int argc, char** argv) {
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
     RegistrationOptions opt = preset_options(scene.preset);
     if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
-    opt.uncertainty.enabled = uncertainty == "linear";
+    opt.uncertainty.enabled = uncertainty != "none";
     // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh (the engine meshes once).
     if (scene.prone_source && cell_mm > 0) scene.prone_source->cell_size = cell_mm * 1e-3;
     RegistrationEngine engine(std::move(scene));
@@ -100,6 +108,10 @@ int main(int argc, char** argv) {
         return true;
       };
     RegistrationResult r = engine.solve(opt, progress);
+    if (uncertainty == "sampling") {
+      std::printf("%s[uncert  ] sampling %d re-registrations...\n", tty && !quiet ? "\n" : "", samples);
+      r.sampled_uncertainty = engine.sample_uncertainty(opt, opt.uncertainty, samples, seed, r);
+    }
     if (tty && !quiet) std::printf("\n");
     if (plan.rigid_landmarks || plan.rigid_icp)
       std::printf("[rigid   ] %.2f deg, %.2f mm (%s) in %.3f s\n", rotation_angle(r.supine_to_model) * 180 / M_PI,
@@ -148,6 +160,19 @@ int main(int argc, char** argv) {
     if (opt.uncertainty.enabled)
       std::printf("[uncert  ] linearised in %.3f s%s%s\n", r.uncertainty_seconds, r.uncertainty_note.empty() ? "" : ": ",
                   r.uncertainty_note.c_str());
+    if (r.sampled_uncertainty) {
+      const SampledUncertainty& su = *r.sampled_uncertainty;
+      for (size_t i = 0; i < su.tumours.size() && i < r.tumours.size(); ++i)
+        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm), mean shift %.2f mm%s\n", r.tumours[i].name.c_str(),
+                    su.tumours[i].radius_95 * 1e3, r.tumours[i].uncertainty ? r.tumours[i].uncertainty->radius_95 * 1e3 : 0.0,
+                    su.tumours[i].mean_shift.norm() * 1e3,
+                    r.tumours[i].has_ground_truth ? (r.tumours[i].centroid_distance <= su.tumours[i].radius_95
+                                                         ? "; holds the true centroid"
+                                                         : "; the true centroid lies outside")
+                                                  : "");
+      std::printf("[sampled ] %d samples (%d not converged, %d failed), %.3f s each%s%s\n", su.samples, su.not_converged,
+                  su.failed, su.seconds_per_sample, su.note.empty() ? "" : ": ", su.note.c_str());
+    }
     const auto files = write_registration_outputs(out_dir, sim, model, r, prepare);
     std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "
                 "(report.json, cross_section.png, registered.vtk, ...)\n",

@@ -179,3 +179,32 @@ TEST(Uncertainty, OptionsOutOfRangeAreRefusedAndNoSurfaceStepIsSaid) {
   EXPECT_NE(r.uncertainty_note.find("surface step did not run"), std::string::npos) << r.uncertainty_note;
   for (const auto& t : r.tumours) EXPECT_FALSE(t.uncertainty);
 }
+
+TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
+  const Scene& s = uncertainty_phantom();
+  RegistrationOptions o = preset_options("fast");
+  RegistrationEngine engine(s);
+  const RegistrationResult nominal = engine.solve(o);
+  UncertaintyOptions u;
+  const SampledUncertainty a = engine.sample_uncertainty(o, u, 4, 3, nominal), b = engine.sample_uncertainty(o, u, 4, 3, nominal);
+  ASSERT_EQ(a.samples, 4);
+  EXPECT_EQ(a.failed, 0);
+  EXPECT_TRUE(a.note.empty()) << a.note;
+  ASSERT_EQ(a.tumours.size(), nominal.tumours.size());
+  for (size_t i = 0; i < a.tumours.size(); ++i) {
+    EXPECT_EQ(a.tumours[i].radius_95, b.tumours[i].radius_95);  // the seed fixes every input
+    EXPECT_GT(a.tumours[i].radius_95, 0.0);
+    EXPECT_GT(a.tumours[i].covariance.trace(), 0.0);
+  }
+  // No source: every sample is the nominal registration.
+  UncertaintyOptions none;
+  none.youngs_modulus_log_sd = none.gravity_direction_deg = none.depth_noise = 0;
+  const SampledUncertainty z = engine.sample_uncertainty(o, none, 3, 3, nominal);
+  for (const auto& t : z.tumours) {
+    EXPECT_LT(t.radius_95, 1e-12);
+    EXPECT_LT(t.covariance.norm(), 1e-20);
+  }
+  expect_throw_with<InputError>([&] { engine.sample_uncertainty(o, u, 1, 3, nominal); }, "at least 2 samples");
+  EXPECT_EQ(percentile_95({3, 1, 2}), 3.0);
+  EXPECT_EQ(percentile_95({}), 0.0);
+}

@@ -135,6 +135,8 @@ struct RegistrationResult {
   std::vector<std::string> warnings;
   std::string uncertainty_note;    ///< what the uncertainty assumed, or why it was not computed
   double uncertainty_seconds = 0;  ///< its cost, not in `seconds`
+  /// Filled by a caller that sampled (RegistrationEngine::sample_uncertainty), for the report.
+  std::optional<SampledUncertainty> sampled_uncertainty;
 };
 
 /// Runs the planned steps. Throws InputError for inconsistent inputs and SolverError for

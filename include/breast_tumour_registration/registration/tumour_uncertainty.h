@@ -94,6 +94,26 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
                                                 const UncertaintyOptions& opt);
 
+/// The spread of the registered tumour centroids over whole re-registrations with sampled
+/// inputs (RegistrationEngine::sample_uncertainty): the reference the linearisation is judged by,
+/// and what the pipeline itself does, stopping criteria included.
+struct SampledUncertainty {
+  struct Tumour {
+    Mat3 covariance = Mat3::Zero();  ///< of the sampled centroids about their mean, supine frame [m^2]
+    double radius_95 = 0;            ///< [m] the 95th percentile of the distance to the nominal centroid
+    Vec3 mean_shift = Vec3::Zero();  ///< sample mean minus the nominal centroid [m]
+  };
+  std::vector<Tumour> tumours;
+  int samples = 0;        ///< registrations that finished
+  int not_converged = 0;  ///< of them, not converged (kept: what the pipeline would have given)
+  int failed = 0;         ///< that threw (left out)
+  double seconds_per_sample = 0;
+  std::string note;       ///< what was not sampled, and why
+};
+
+/// The 95th percentile of the distances, by the nearest rank (0 for none).
+double percentile_95(std::vector<double> distances);
+
 /// The radius of the sphere about the mean holding 95 % of N(0, covariance) (deterministic
 /// quadrature over the eigenvalues: exact to 1e-4 relative).
 double radius_95(const Mat3& covariance);
