@@ -253,7 +253,10 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
   try {
     if (!engine_) throw InputError("the node is not ready: " + scene_error_ + "; fix it and restart the node");
     const std::string preset = req.preset.empty() ? params_.preset : req.preset;
-    const RegistrationOptions opt = preset_options(preset);
+    RegistrationOptions opt = preset_options(preset);
+    if (req.uncertainty != "" && req.uncertainty != "none" && req.uncertainty != "linear")
+      throw InputError("request field 'uncertainty': '" + req.uncertainty + "' is not one of \"\", none, linear");
+    opt.uncertainty.enabled = req.uncertainty == "linear";
     std::optional<LiveScan> scan;
     LiveSceneOptions lo;
     if (req.use_latest_cloud) {
@@ -337,6 +340,7 @@ void RegistrationNode::publish_result(const RegistrationResult& r, const Registr
   out.landmark_residual_mean = r.landmark_residual_mean;
   out.skin_distance_mean = r.skin_distance_mean;
   out.warnings = r.warnings;
+  out.uncertainty_note = r.uncertainty_note;
   for (const auto& s : r.reports) {
     out.step_names.push_back(s.name);
     out.step_seconds.push_back(s.seconds);
@@ -359,6 +363,13 @@ void RegistrationNode::publish_result(const RegistrationResult& r, const Registr
     tm.prone_axis_ratio = t.prone_axis_ratio;
     tm.has_ground_truth = t.has_ground_truth;
     tm.centroid_error = t.centroid_distance;
+    if (t.uncertainty) {
+      tm.has_uncertainty = true;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)  // symmetric to the bit (the frame change leaves round-off)
+          tm.centroid_covariance[3 * a + b] = 0.5 * (t.uncertainty->covariance(a, b) + t.uncertainty->covariance(b, a));
+      tm.radius_95 = t.uncertainty->radius_95;
+    }
     out.tumours.push_back(tm);
     auto mk = ros_conv::to_marker(t.registered, frame, "tumour", id++, 0.9f, 0.2f, 0.2f, 0.9f);
     mk.header.stamp = now;

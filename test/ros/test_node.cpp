@@ -164,6 +164,30 @@ TEST(RegistrationNode, ReplayedBagGivesTheTumourWithinThreeMillimetresThePoseWit
   EXPECT_LT(trans, 0.5e-3);
 }
 
+TEST(RegistrationNode, UncertaintyOnRequestAndAWrongValueIsNamed) {
+  breast_tumour_registration::Register srv;
+  srv.request.use_latest_cloud = false;  // the scene's own supine surface
+  srv.request.uncertainty = "linear";
+  ASSERT_TRUE(ros::service::call(kService, srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  ASSERT_FALSE(srv.response.result.tumours.empty());
+  for (const auto& t : srv.response.result.tumours) {
+    EXPECT_TRUE(t.has_uncertainty) << t.name;
+    EXPECT_GT(t.radius_95, 0.0) << t.name;
+    for (int a = 0; a < 3; ++a) EXPECT_GE(t.centroid_covariance[4 * a], 0.0) << t.name;  // the diagonal
+    EXPECT_DOUBLE_EQ(t.centroid_covariance[1], t.centroid_covariance[3]) << t.name;  // symmetric
+  }
+  srv.request.uncertainty = "bogus";
+  ASSERT_TRUE(ros::service::call(kService, srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("uncertainty"), std::string::npos) << srv.response.message;
+  // Without the field, none is computed.
+  srv.request.uncertainty = "";
+  ASSERT_TRUE(ros::service::call(kService, srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  for (const auto& t : srv.response.result.tumours) EXPECT_FALSE(t.has_uncertainty);
+}
+
 // Run by bad_parameter*.test only (node.test filters it out): a node started with a
 // parameter out of range, or of the wrong type, keeps running and answers with the
 // parameter's name (~expected: the text the answer must hold).
