@@ -377,7 +377,10 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       r.uncertainty_seconds = u.seconds;
       std::vector<std::string> notes;
       if (!u.note.empty()) notes.push_back(u.note);
-      if (r.pose_solved_with_surface) notes.push_back("the rigid pose is held at its solution");
+      if (r.pose_solved_with_surface)
+        notes.push_back("the rigid pose is held at its solution, but here it is solved with the deformation: on such a "
+                        "body (no rigid region) the linear region came out 3 to 5 times smaller than sampled "
+                        "re-registrations; use --uncertainty sampling");
       if (!r.converged) notes.push_back("linearised at a state that is not converged");
       for (const auto& n : notes) r.uncertainty_note += (r.uncertainty_note.empty() ? "" : "; ") + n;
     }
