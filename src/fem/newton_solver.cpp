@@ -145,7 +145,6 @@ NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahed
 NewtonSolver::~NewtonSolver() = default;
 
 void NewtonSolver::forget_factor() { impl_->have_factor = false; }
-bool NewtonSolver::analyzed() const { return impl_->analyzed; }
 
 NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
   const auto t_start = Clock::now();

@@ -56,10 +56,4 @@ const SkinningSubspace& StepSolvers::subspace(const RegistrationModel& model, co
   return subspace_->subspace;
 }
 
-int StepSolvers::analyzed() const {
-  int k = 0;
-  for (const auto& [key, p] : solvers_) k += p.solver->analyzed() ? 1 : 0;
-  return k;
-}
-
 }  // namespace btr

@@ -157,13 +157,10 @@ class NewtonSolver {
   NewtonResult solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt);
 
   HessianAssembler& assembler() { return *assembler_; }
-  const Tetrahedra& tetrahedra() const { return tets_; }
 
   /// Drops the numeric factor (the symbolic analysis stays): the next solve starts as a new
   /// solver would, without a lagged factor of an earlier problem as its preconditioner.
   void forget_factor();
-  /// Whether the symbolic analysis has been done (by an earlier solve).
-  bool analyzed() const;
 
  private:
   struct Impl;

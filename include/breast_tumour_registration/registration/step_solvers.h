@@ -32,8 +32,6 @@ class StepSolvers {
 
   int built() const { return built_; }    ///< solvers and subspaces built
   int reused() const { return reused_; }  ///< handed out from the cache
-  /// Solvers whose symbolic analysis was done at least once (for the reports).
-  int analyzed() const;
 
  private:
   struct Pattern {
