@@ -14,6 +14,11 @@
 
 namespace btr {
 
+bool holds_projection(const Projection& c, const SurfaceStepOptions& opt) {
+  if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) return false;
+  return !(opt.reject_boundary && c.on_boundary);
+}
+
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
                         Points& x, const StepCallback& callback, Rigid* pose, const PosePoints* pose_points,
                         StepSolvers* cache) {
@@ -71,8 +76,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       const Projection c = supine.project(here);
       const double m = outer > 1 ? (here - skin_before.row(i).transpose()).norm() : std::numeric_limits<double>::infinity();
       skin_before.row(i) = here.transpose();
-      if (opt.max_projection_distance > 0 && c.distance > opt.max_projection_distance) continue;
-      if (opt.reject_boundary && c.on_boundary) continue;
+      if (!holds_projection(c, opt)) continue;
       // Convergence is judged on the constraints that act (a dropped projection onto a
       // scan's border slides along it as the skin moves).
       moved = std::max(moved, m);

@@ -88,8 +88,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   const Rigid to_model = model_to_projector.inverse();
   for (int v : model.skin) {
     const Projection c = supine.project(model_to_projector * Vec3(x.row(v).transpose()));
-    if (surface.max_projection_distance > 0 && c.distance > surface.max_projection_distance) continue;
-    if (surface.reject_boundary && c.on_boundary) continue;
+    if (!holds_projection(c, surface)) continue;
     held.push_back({v, to_model * c.point, (R_p.transpose() * c.normal).normalized()});
   }
   return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt);

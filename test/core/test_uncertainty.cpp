@@ -19,18 +19,6 @@ using btr::test::expect_throw_with;
 
 namespace {
 
-const Scene& uncertainty_phantom() {
-  static const Scene s = [] {
-    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom_uncertainty").string();
-    std::filesystem::remove_all(d);
-    PhantomSceneOptions o;
-    o.phantom.tet.cell_size = 0.012;
-    o.phantom.surface_rings = 12;
-    write_phantom_scene(d, o);
-    return load_scene(d + "/scene.yaml");
-  }();
-  return s;
-}
 
 }  // namespace
 
@@ -68,7 +56,7 @@ TEST(Uncertainty, The95PercentRadiusOfKnownDistributions) {
 // The linearised result's structure on a converged registration (its agreement with re-solves
 // is not yet established: tumour_uncertainty.h).
 TEST(Uncertainty, TheCovarianceIsTheSumOfItsSourcesAndTheRadiusCoversItsLargestAxis) {
-  const Scene& s = uncertainty_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   RegistrationOptions o = preset_options("balanced");
   o.uncertainty.enabled = true;
   const RegistrationResult r = RegistrationEngine(s).solve(o);
@@ -99,7 +87,7 @@ TEST(Uncertainty, TheCovarianceIsTheSumOfItsSourcesAndTheRadiusCoversItsLargestA
 // of the very energy it differentiates: the surface step's last Newton problem with its
 // projections held, re-solved to round-off at perturbed E and gravity.
 TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
-  const Scene& s = uncertainty_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   RegistrationOptions o = preset_options("balanced");
   o.uncertainty.enabled = true;
   o.uncertainty.held_projections = true;
@@ -114,7 +102,7 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
   std::vector<HeldSkinVertex> held;
   for (int v : model.skin) {
     const Projection c = supine->project(Vec3(r.x.row(v).transpose()));
-    if (c.distance > o.surface.max_projection_distance || c.on_boundary) continue;
+    if (!holds_projection(c, o.surface)) continue;
     held.push_back({v, c.point, c.normal.normalized()});
   }
   auto resolve = [&](double log_e, const Vec3& gravity) {
@@ -171,7 +159,7 @@ TEST(Uncertainty, OptionsOutOfRangeAreRefusedAndNoSurfaceStepIsSaid) {
   UncertaintyOptions u;
   u.depth_noise = -1;
   expect_throw_with<InputError>([&] { validate_uncertainty_options(u); }, "depth_noise");
-  Scene s = uncertainty_phantom();
+  Scene s = btr::test::coarse_phantom_scene();
   s.steps = {"rigid", "landmarks"};
   RegistrationOptions o = preset_options("fast");
   o.uncertainty.enabled = true;
@@ -181,7 +169,7 @@ TEST(Uncertainty, OptionsOutOfRangeAreRefusedAndNoSurfaceStepIsSaid) {
 }
 
 TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
-  const Scene& s = uncertainty_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   RegistrationOptions o = preset_options("fast");
   RegistrationEngine engine(s);
   const RegistrationResult nominal = engine.solve(o);

@@ -40,6 +40,10 @@ struct SurfaceStepOptions {
   NewtonOptions newton;
 };
 
+/// Whether the surface step holds a skin vertex by this projection: within
+/// max_projection_distance (when > 0) and, with reject_boundary, not on the surface's border.
+bool holds_projection(const Projection& c, const SurfaceStepOptions& opt);
+
 /// supine: projection onto the supine surface in the model frame (a mesh, closed or open,
 /// or a point cloud). x: current positions, updated in place.
 /// pose == nullptr: the surface stays where it is. Otherwise it may move rigidly and its pose
