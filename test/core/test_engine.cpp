@@ -12,18 +12,6 @@ using btr::test::make_rigid;
 
 namespace {
 
-const Scene& engine_phantom() {
-  static const Scene s = [] {
-    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom_engine").string();
-    std::filesystem::remove_all(d);
-    PhantomSceneOptions o;
-    o.phantom.tet.cell_size = 0.012;
-    o.phantom.surface_rings = 12;
-    write_phantom_scene(d, o);
-    return load_scene(d + "/scene.yaml");
-  }();
-  return s;
-}
 
 double largest_difference(const Points& a, const Points& b) {
   EXPECT_EQ(a.rows(), b.rows());
@@ -39,7 +27,7 @@ RegistrationResult fresh(const Scene& s, const RegistrationOptions& opt) {
 }  // namespace
 
 TEST(Engine, RepeatedSolvesGiveTheFreshAnswerAndReuseEveryStepsSolver) {
-  const Scene& s = engine_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   const RegistrationOptions opt = preset_options("balanced");
   const RegistrationResult reference = fresh(s, opt);
   ASSERT_TRUE(reference.converged);
@@ -61,7 +49,7 @@ TEST(Engine, RepeatedSolvesGiveTheFreshAnswerAndReuseEveryStepsSolver) {
 }
 
 TEST(Engine, EachSimulationMeshIsPreparedOnceAndKept) {
-  const Scene& s = engine_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   RegistrationEngine engine(s);
   RegistrationOptions own = preset_options("balanced");  // 7 mm: coarser than this 12 mm mesh, so no remeshing
   const PreparedScene& a = engine.prepare(own);
@@ -79,7 +67,7 @@ TEST(Engine, EachSimulationMeshIsPreparedOnceAndKept) {
 }
 
 TEST(Engine, AnotherSupineSideIsRegisteredOnThePreparedProneSide) {
-  const Scene& s = engine_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   const RegistrationOptions opt = preset_options("balanced");
   RegistrationEngine engine(s);
   engine.solve(opt);
@@ -97,7 +85,7 @@ TEST(Engine, AnotherSupineSideIsRegisteredOnThePreparedProneSide) {
 }
 
 TEST(Engine, AnAdoptedModelIsSolvedAsGivenWhateverThePresetsMesh) {
-  const Scene& s = engine_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   std::vector<std::string> warnings;
   RegistrationModel m = prepare_model(s, warnings);
   const long tets = m.rest.T.rows();

@@ -16,18 +16,6 @@ using btr::test::make_rigid;
 
 namespace {
 
-const Scene& live_phantom() {
-  static const Scene s = [] {
-    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom_live").string();
-    std::filesystem::remove_all(d);
-    PhantomSceneOptions o;
-    o.phantom.tet.cell_size = 0.012;
-    o.phantom.surface_rings = 12;
-    write_phantom_scene(d, o);
-    return load_scene(d + "/scene.yaml");
-  }();
-  return s;
-}
 
 // The supine skin seen by a camera 0.4 m above the breast, in the working frame, where the
 // scene's supine frame sits at `supine_to_working`.
@@ -52,7 +40,7 @@ LiveScan scan_of(const Scene& s, const Rigid& supine_to_working) {
 }  // namespace
 
 TEST(LiveScene, AnOrganizedScanBecomesTheSupineSurfaceAndThePoseMovesTheRest) {
-  const Scene& s = live_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   const Rigid T = make_rigid(Vec3(3, -2, 10), Vec3(0.02, -0.01, 0.05));
   const LiveScene live = live_scene(s, scan_of(s, T));
   ASSERT_TRUE(live.scene.supine_surface);
@@ -77,7 +65,7 @@ TEST(LiveScene, AnOrganizedScanBecomesTheSupineSurfaceAndThePoseMovesTheRest) {
 }
 
 TEST(LiveScene, AnUnorganizedScanIsUsedAsItsFinitePointsAndLandmarksCanBeLeftOut) {
-  const Scene& s = live_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   LiveScan scan = scan_of(s, Rigid::Identity());
   const Eigen::Index finite = finite_points(scan.cloud).rows();
   ASSERT_LT(finite, scan.cloud.rows());  // the camera sees background pixels as NaN
@@ -94,7 +82,7 @@ TEST(LiveScene, AnUnorganizedScanIsUsedAsItsFinitePointsAndLandmarksCanBeLeftOut
 }
 
 TEST(LiveScene, AScanThatGivesNothingIsAClearError) {
-  const Scene& s = live_phantom();
+  const Scene& s = btr::test::coarse_phantom_scene();
   LiveScan nan_scan;
   nan_scan.cloud = Points::Constant(12, 3, std::numeric_limits<double>::quiet_NaN());
   nan_scan.width = 4;

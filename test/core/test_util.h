@@ -10,6 +10,8 @@
 #include <string>
 
 #include "breast_tumour_registration/geometry/rigid_transform.h"
+#include "breast_tumour_registration/io/scene.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 
 namespace btr::test {
 
@@ -21,6 +23,21 @@ inline std::string temp_dir() {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
+}
+
+/// One coarse phantom scene (12 mm cells, 12 surface rings, E = 3400 Pa, 2.2k tetrahedra),
+/// written once per test process and loaded; shared by the tests that only read it.
+inline const Scene& coarse_phantom_scene() {
+  static const Scene s = [] {
+    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12_shared").string();
+    std::filesystem::remove_all(d);
+    PhantomSceneOptions o;
+    o.phantom.tet.cell_size = 0.012;
+    o.phantom.surface_rings = 12;
+    write_phantom_scene(d, o);
+    return load_scene(d + "/scene.yaml");
+  }();
+  return s;
 }
 
 inline void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
