@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   app.add_option("--cell-sizes", cells, "simulation mesh cell sizes to sweep [mm]");
   app.add_option("-o,--out", out_path, "CSV file")->capture_default_str();
   std::vector<std::string> knobs;
-  app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections");
+  app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance");
   CLI11_PARSE(app, argc, argv);
   try {
     const Scene scene = load_scene(scene_path);
@@ -81,6 +81,16 @@ int main(int argc, char** argv) {
       for (int k : {1, 2, 3, 4, 6, 10, 20, 40}) {
         Point p{"max_projections", std::to_string(k), "balanced", c, preset_options("balanced")};
         p.opt.surface.max_projections = k;
+        points.push_back(p);
+      }
+      for (int d : {0, 2, 5, 8}) {  // 0: the thesis's plain projection/Newton alternation
+        Point p{"anderson_depth", std::to_string(d), "balanced", c, preset_options("balanced")};
+        p.opt.surface.anderson_depth = d;
+        points.push_back(p);
+      }
+      for (double tol : {4e-4, 2e-4, 1e-4, 5e-5, 2e-5}) {  // the surface step's distance to its fixed point [m]
+        Point p{"projection_tolerance", fmt(tol * 1e3), "balanced", c, preset_options("balanced")};
+        p.opt.surface.projection_tolerance = tol;
         points.push_back(p);
       }
     }

@@ -6,11 +6,13 @@
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/anderson_acceleration.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/plane_constraint_energy.h"
 #include "breast_tumour_registration/fem/point_constraint_energy.h"
 #include "breast_tumour_registration/fem/rigid_free_surface_energy.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 
 namespace btr {
 
@@ -25,6 +27,9 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   const auto t0 = std::chrono::steady_clock::now();
   if (opt.max_projections < 1 || opt.newton_per_projection < 1)
     throw InputError("surface step: max_projections and newton_per_projection must be >= 1");
+  if (opt.anderson_depth < 0 || opt.floor_projections < 1 || opt.stall_projections < 1 || !(opt.projection_tolerance >= 0))
+    throw InputError("surface step: anderson_depth must be >= 0, floor_projections and stall_projections >= 1, "
+                     "projection_tolerance a number >= 0");
 
   TotalEnergy energy;
   add_model_elastic_energy(energy, model);
@@ -48,70 +53,80 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
 
   StepReport rep;
   rep.name = pose ? "surface (pose free)" : "surface";
+  rep.skin_vertices = static_cast<int>(model.skin.size());
   Rigid P = Rigid::Identity();  // model frame -> the projector's frame (moves only when pose != nullptr)
-  std::vector<int> held;
-  Points held_y, held_n;
+  std::vector<int> held;        // skin indices (into model.skin) the last projection holds
+  Points held_y(static_cast<Eigen::Index>(model.skin.size()), 3), held_n(static_cast<Eigen::Index>(model.skin.size()), 3);
   rep.t_setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  // The held skin where the previous projection saw it (projector frame): convergence is the
-  // skin no longer moving between projections. The projections themselves jitter along a
-  // noisy scan (a depth camera's) without moving the skin, so their change is no criterion.
-  Points skin_before = Points::Constant(static_cast<Eigen::Index>(model.skin.size()), 3, std::numeric_limits<double>::quiet_NaN());
-  int offset = 0;
-  bool finished = false;  // the loop ended for a reason of its own, not on the cap
-  double least_motion = std::numeric_limits<double>::infinity();
-  int least_at = 0;
-  for (int outer = 1; outer <= opt.max_projections; ++outer) {
+
+  // The springs for the projections of the skin of xs (and, with a free pose, the pose that
+  // best fits xs to the previous correspondences). Returns how many skin vertices they hold.
+  auto project_at = [&](const Points& xs, bool update_pose) {
     const auto tp = std::chrono::steady_clock::now();
     points->clear();
     planes->clear();
     held.clear();
-    double moved = 0, moved_sq = 0;
-    int kept = 0;
-    if (pose && outer > 1 && free_springs->size() >= 3) P = free_springs->pose(x);  // fewer: keep the last pose
-    held_y.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
-    held_n.resize(static_cast<Eigen::Index>(model.skin.size()), 3);
+    std::vector<int> verts;
+    if (pose && update_pose && free_springs->size() >= 3) P = free_springs->pose(xs);  // fewer: keep the last pose
     for (size_t i = 0; i < model.skin.size(); ++i) {
       const int v = model.skin[i];
-      const Vec3 here = P * Vec3(x.row(v).transpose());
-      const Projection c = supine.project(here);
-      const double m = outer > 1 ? (here - skin_before.row(i).transpose()).norm() : std::numeric_limits<double>::infinity();
-      skin_before.row(i) = here.transpose();
+      const Projection c = supine.project(P * Vec3(xs.row(v).transpose()));
       if (!holds_projection(c, opt)) continue;
-      // Convergence is judged on the constraints that act (a dropped projection onto a
-      // scan's border slides along it as the skin moves).
-      moved = std::max(moved, m);
-      moved_sq += m * m;
+      const Eigen::Index k = static_cast<Eigen::Index>(held.size());
       if (pose) {
-        held_y.row(kept) = c.point.transpose();
-        held_n.row(kept) = c.normal.transpose();
-        held.push_back(v);
+        held_y.row(k) = c.point.transpose();
+        held_n.row(k) = c.normal.transpose();
+        verts.push_back(v);
       } else {
         points->add(Anchor::vertex(v), c.point);
         planes->add(Anchor::vertex(v), c.point, c.normal);
       }
-      ++kept;
+      held.push_back(static_cast<int>(i));
     }
-    if (pose) free_springs->set(held, held_y.topRows(kept), held_n.topRows(kept));
-    const double moved_rms = kept ? std::sqrt(moved_sq / kept) : 0.0;
+    const Eigen::Index kept = static_cast<Eigen::Index>(held.size());
+    if (pose) free_springs->set(verts, held_y.topRows(kept), held_n.topRows(kept));
     rep.t_projection += std::chrono::duration<double>(std::chrono::steady_clock::now() - tp).count();
-    rep.projection_rms_change = moved_rms;
-    rep.constrained_skin = kept;
-    rep.skin_vertices = static_cast<int>(model.skin.size());
-    rep.projection_max_change = moved;
     if (kept == 0)
       throw InputError("surface step: no skin vertex projects inside the supine surface within " + std::to_string(opt.max_projection_distance) +
                        " m of the supine surface; is the scan aligned with the model?");
+    return static_cast<int>(kept);
+  };
+  // RMS over the held skin of the rows of a - b [m].
+  auto held_rms = [&](const Points& a, const Points& b) {
+    double s = 0;
+    for (int i : held) s += (a.row(model.skin[static_cast<size_t>(i)]) - b.row(model.skin[static_cast<size_t>(i)])).squaredNorm();
+    return held.empty() ? 0.0 : std::sqrt(s / static_cast<double>(held.size()));
+  };
+
+  // The fixed-point iteration x <- G(x): project the skin of x, one Newton step on those
+  // projections (thesis Algorithm 2), with Anderson acceleration where it lowers the merit
+  // (the energy with the springs of a state's own projections). Convergence bounds the distance
+  // to the fixed point, not the last step: |x - x*| <= |G(x) - x| / (1 - q) for a contraction
+  // q, estimated by the rate at which the residual falls (on soft tissue q is 0.8 to 0.9, so a
+  // small step is far from the answer).
+  const Eigen::Index dim = x.size();
+  auto as_vector = [&](const Points& p) { return Eigen::Map<const Eigen::VectorXd>(p.data(), dim); };
+  std::unique_ptr<AndersonAcceleration> aa;
+  if (opt.anderson_depth > 0) aa = std::make_unique<AndersonAcceleration>(opt.anderson_depth);
+  rep.constrained_skin = project_at(x, false);
+  double merit = energy.value(x);
+  long inverted_now = count_inverted(x, model.rest.T);
+  Points g;
+  int offset = 0;
+  bool finished = false;  // the loop ended for a reason of its own, not on the cap
+  double least_residual = std::numeric_limits<double>::infinity();
+  int least_at = 0;
+  std::vector<double> residuals;  // per projection [m]
+  for (int outer = 1; outer <= opt.max_projections; ++outer) {
     if (callback) nopt.callback = [&](const IterationInfo& it) {
       IterationInfo shifted = it;
       shifted.iteration += offset;
       shifted.elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       return callback("surface", shifted);
     };
-    // Once the projections have settled, Newton runs to its gradient criterion on them:
-    // converged means both held, not that a budget ran out.
-    const bool settled = outer > 1 && moved_rms <= opt.projection_tolerance;
-    nopt.max_iterations = settled ? std::max(opt.newton_per_projection, opt.newton.max_iterations) : opt.newton_per_projection;
-    const NewtonResult r = solver.solve(energy, x, nopt);
+    g = x;
+    nopt.max_iterations = opt.newton_per_projection;
+    NewtonResult r = solver.solve(energy, g, nopt);
     offset += r.iterations;
     rep.add_newton_profile(r);
     rep.iterations += r.iterations;
@@ -120,35 +135,125 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.gradient_norm = r.gradient_norm;
     rep.stop_reason = to_string(r.reason);
     finished = true;
-    if (r.reason == StopReason::Aborted) break;
-    if (r.reason == StopReason::Stalled || r.reason == StopReason::LineSearchFailed ||
-        r.reason == StopReason::InvertedAfterStall) {
+    if (r.reason == StopReason::Aborted) {
+      x = g;
+      break;
+    }
+    if (r.reason == StopReason::Stalled || r.reason == StopReason::LineSearchFailed || r.reason == StopReason::InvertedAfterStall) {
+      x = g;
       rep.stop_reason = "Newton " + rep.stop_reason + " (gradient " + std::to_string(r.gradient_norm) + " N)";
       break;
     }
-    if (settled) {
+    // The fixed-point residual and the contraction between this iterate and the last; the
+    // bound needs two contraction estimates (the first step, from the landmark step's state,
+    // contracts far more than the slow tangential relaxation after it).
+    const double residual = held_rms(g, x);
+    residuals.push_back(residual);
+    // The contraction: the larger of the last two residual ratios (cautious; NaN until both
+    // exist). For the plain iteration it is the map's contraction; with Anderson's iterates the
+    // rate at which the residual falls.
+    double q_hat = std::numeric_limits<double>::quiet_NaN();
+    if (residuals.size() >= 3) {
+      const size_t k = residuals.size() - 1;
+      q_hat = std::max(residuals[k] / residuals[k - 1], residuals[k - 1] / residuals[k - 2]);
+    }
+    const double distance = q_hat < 1 ? residual / (1 - q_hat) : std::numeric_limits<double>::infinity();
+    rep.projection_rms_change = residual;
+    rep.projection_max_change = 0;
+    for (int i : held) rep.projection_max_change = std::max(rep.projection_max_change, (g.row(model.skin[static_cast<size_t>(i)]) - x.row(model.skin[static_cast<size_t>(i)])).norm());
+    rep.contraction = q_hat;
+    rep.fixed_point_distance = distance;
+    // The alternation's floor: on a polyhedral surface the closest points switch between
+    // faces, and the skin ends jittering by a few hundredths of a millimetre per projection
+    // without a contraction to measure. When the residual has not reached a new low for
+    // floor_projections and none of them moved more than the tolerance, the skin jitters
+    // within the tolerance of where it settles (no closer fixed point to estimate).
+    double floor_spread = std::numeric_limits<double>::infinity();
+    if (static_cast<int>(residuals.size()) > opt.floor_projections && residual >= least_residual) {
+      floor_spread = 0;
+      for (size_t k = residuals.size() - static_cast<size_t>(opt.floor_projections) - 1; k < residuals.size(); ++k)
+        floor_spread = std::max(floor_spread, residuals[k]);
+      if (outer - least_at < opt.floor_projections) floor_spread = std::numeric_limits<double>::infinity();
+    }
+    const bool bounded = distance <= opt.projection_tolerance;
+    const bool at_floor = floor_spread <= opt.projection_tolerance;
+    if (bounded || at_floor) {
+      // Settled: Newton runs to its gradient criterion on these projections, so converged
+      // means both held, not that a budget ran out.
+      nopt.max_iterations = std::max(opt.newton_per_projection, opt.newton.max_iterations);
+      r = solver.solve(energy, g, nopt);
+      offset += r.iterations;
+      rep.add_newton_profile(r);
+      rep.iterations += r.iterations;
+      rep.energy = r.energy;
+      rep.gradient_norm = r.gradient_norm;
       rep.converged = r.converged;
-      rep.stop_reason = r.converged ? "the skin stopped moving between projections and the gradient criterion held"
-                                    : "the skin stopped moving between projections but Newton reached its iteration cap";
+      if (!bounded) rep.fixed_point_distance = floor_spread;
+      const std::string how = bounded ? "the skin settled (estimated " + std::to_string(distance * 1e3) +
+                                            " mm RMS from the fixed point, contraction " + std::to_string(q_hat) + ")"
+                                      : "the skin settled to its jitter floor (" + std::to_string(floor_spread * 1e3) +
+                                            " mm RMS per projection at most over the last " + std::to_string(opt.floor_projections + 1) +
+                                            " projections)";
+      rep.stop_reason = r.converged ? how + " and the gradient criterion held"
+                                    : how + " but Newton reached its iteration cap (" + to_string(r.reason) + ")";
+      x = g;
       break;
     }
-    // A stall: the skin's motion has not come down for stall_projections projections (on a
-    // noisy scan it settles into a jitter above the tolerance). Not converged; no use going on.
-    if (outer > 1 && moved_rms < least_motion) {
-      least_motion = moved_rms;
+    // A stall: the residual has not come down for stall_projections projections (on a noisy
+    // scan it settles into a jitter). Not converged; no use going on.
+    if (residual < least_residual) {
+      least_residual = residual;
       least_at = outer;
-    } else if (outer > 1 && outer - least_at >= opt.stall_projections) {
-      rep.stop_reason = "stalled: the skin keeps moving " + std::to_string(moved_rms * 1e3) + " mm RMS between projections (least " +
-                        std::to_string(least_motion * 1e3) + " mm, " + std::to_string(opt.stall_projections) +
-                        " projections ago; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm): a noisy scan?";
+    }
+    if (outer - least_at >= opt.stall_projections) {
+      x = g;
+      rep.stop_reason = "stalled: the skin keeps moving " + std::to_string(residual * 1e3) + " mm RMS per projection (least " +
+                        std::to_string(least_residual * 1e3) + " mm, " + std::to_string(outer - least_at) +
+                        " projections ago; tolerance " + std::to_string(opt.projection_tolerance * 1e3) +
+                        " mm from the fixed point): a noisy scan?";
       break;
     }
     finished = false;
+    if (outer == opt.max_projections) {
+      x = g;
+      break;
+    }
+    // The next iterate: Anderson's proposal where it lowers the merit without inverting more
+    // elements than the plain step, else the plain step (and the history starts over).
+    bool accepted = false;
+    if (aa) {
+      const Eigen::VectorXd proposal = aa->next(as_vector(x), as_vector(g));
+      if (aa->columns() > 0 && proposal.allFinite()) {
+        Points cand = Eigen::Map<const Points>(proposal.data(), x.rows(), 3);
+        for (Eigen::Index v = 0; v < x.rows(); ++v)  // fixed vertices stay (their rows agree in x and g anyway)
+          if (model.fixed[static_cast<size_t>(v)]) cand.row(v) = g.row(v);
+        const long inv = count_inverted(cand, model.rest.T);
+        if (inv <= std::max(r.inverted, inverted_now)) {
+          rep.constrained_skin = project_at(cand, true);
+          const double m = energy.value(cand);
+          if (std::isfinite(m) && m <= merit) {
+            x = cand;
+            merit = m;
+            inverted_now = inv;
+            accepted = true;
+            ++rep.accelerated_projections;
+          }
+        }
+        if (!accepted) aa->reset();
+      }
+    }
+    if (!accepted) {
+      x = g;
+      rep.constrained_skin = project_at(x, true);
+      merit = energy.value(x);
+      inverted_now = r.inverted;
+    }
   }
   if (!finished)
-    rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached with the skin still moving " +
-                      std::to_string(rep.projection_rms_change * 1e3) + " mm RMS (tolerance " +
-                      std::to_string(opt.projection_tolerance * 1e3) + " mm)";
+    rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached, the skin still moving " +
+                      std::to_string(rep.projection_rms_change * 1e3) + " mm RMS per projection (estimated " +
+                      (std::isfinite(rep.fixed_point_distance) ? std::to_string(rep.fixed_point_distance * 1e3) + " mm" : std::string("an unknown distance")) +
+                      " from the fixed point; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm)";
   if (pose) *pose = free_springs->size() >= 3 ? free_springs->pose(x) : P;
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;

@@ -92,6 +92,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
       << ", \"projections\": " << s.outer_iterations << ", \"seconds\": " << num(s.seconds)
       << ", \"energy_J\": " << num(s.energy) << ", \"gradient_norm_N\": " << num(s.gradient_norm)
       << ", \"projection_rms_change_mm\": " << num(s.projection_rms_change * 1e3)
+      << ", \"fixed_point_distance_mm\": " << num(s.fixed_point_distance * 1e3) << ", \"contraction\": " << num(s.contraction)
+      << ", \"accelerated_projections\": " << s.accelerated_projections
       << ", \"constrained_skin_vertices\": " << s.constrained_skin << ", \"skin_vertices\": " << s.skin_vertices
       << ", \"inverted_tetrahedra\": " << s.inverted << ", \"inversions_allowed\": " << (s.inversions_allowed ? "true" : "false")
       << ",\n     \"profile_seconds\": {\"setup\": "

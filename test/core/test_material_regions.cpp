@@ -75,7 +75,7 @@ TEST(MaterialRegions, TheLabelledPhantomGivesEachTissueItsMaterial) {
   EXPECT_NE(json.find("{\"name\": \"gland\", \"youngs_modulus_Pa\": 6800, \"tetrahedra\": " + std::to_string(gland) + "}"),
             std::string::npos)
       << json.substr(0, 800);
-  EXPECT_TRUE(r.converged);
+  EXPECT_TRUE(r.converged) << btr::test::step_stops(r);
   // Our own FEM made this truth with these materials: the method told them lands on it.
   for (const auto& t : r.tumours) EXPECT_LT(t.centroid_distance, 1e-4) << t.name;
 }

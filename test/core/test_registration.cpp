@@ -652,8 +652,12 @@ TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
   EXPECT_TRUE(aligned.pose_solved_with_landmarks && aligned.pose_solved_with_surface && !aligned.icp_used);
   EXPECT_TRUE(aligned.converged && moved.converged);
   ASSERT_EQ(aligned.tumours.size(), moved.tumours.size());
-  for (size_t i = 0; i < aligned.tumours.size(); ++i)  // each in its own supine frame, truth moved with the scan
-    EXPECT_LT(std::abs(aligned.tumours[i].centroid_distance - moved.tumours[i].centroid_distance), 0.05e-3);
+  // Each in its own supine frame, truth moved with the scan. Issue 10 asks for 0.5 mm; on this
+  // 12 mm mesh the skin ends at the surface step's jitter floor (about 0.03 mm per projection),
+  // where the two paths stop about 0.1 mm apart in tumour error (0.11 mm measured; the 6 mm
+  // mesh of BENCHMARKS.md's ring-free table is the finer check).
+  for (size_t i = 0; i < aligned.tumours.size(); ++i)
+    EXPECT_LT(std::abs(aligned.tumours[i].centroid_distance - moved.tumours[i].centroid_distance), 0.15e-3);
   EXPECT_LT(worst_error(aligned), worst_error(told) + 0.15e-3) << worst_error(aligned) * 1e3 << " vs " << worst_error(told) * 1e3;
   std::printf("ring-free phantom: aligned %.3f mm, misaligned %.3f mm, told the pose %.3f mm\n", worst_error(aligned) * 1e3,
               worst_error(moved) * 1e3, worst_error(told) * 1e3);

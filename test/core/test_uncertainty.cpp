@@ -128,14 +128,18 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     n.step_tolerance = 1e-15;
     n.reuse_factorization = false;
     Points x = r.x;
-    EXPECT_TRUE(solver.solve(energy, x, n).converged);
+    const NewtonResult nr = solver.solve(energy, x, n);
+    // Tolerances far below round-off: a stall at 1e-8 N of a 3 N weight is the minimum too.
+    EXPECT_TRUE(nr.converged || nr.gradient_norm < 1e-6) << to_string(nr.reason) << ", gradient " << nr.gradient_norm << " N after " << nr.iterations;
     std::vector<Vec3> c;
     for (const auto& t : m.tumours) c.push_back(T.inverse() * volume_centroid({apply_embedding(t.embedding, m.rest.T, x), t.prone.F}));
     return std::make_pair(x, c);
   };
-  // The balanced result is near, not at, this energy's minimum (0.28 mm): linearise at the
-  // minimum, with the same held targets, so that both sides describe one equilibrium.
+  // The balanced result is near, not at, this energy's minimum (its held projections are those
+  // of the last iterate, not of the minimum): linearise at the minimum, with the same held
+  // targets, so that both sides describe one equilibrium.
   const Points x0 = resolve(0, model.gravity).first;
+  std::printf("balanced result to the minimum of its held energy: %.3f mm at most\n", 1e3 * (x0 - r.x).rowwise().norm().maxCoeff());
   const UncertaintyResult lin = linearised_tumour_uncertainty(model, x0, held, T.inverse(), o.surface, o.uncertainty);
   const double h = 1e-3;
   const Vec3 axis = model.gravity.normalized().unitOrthogonal();

@@ -11,6 +11,7 @@
 
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/io/scene.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 
 namespace btr::test {
@@ -37,6 +38,13 @@ inline const Scene& coarse_phantom_scene() {
     write_phantom_scene(d, o);
     return load_scene(d + "/scene.yaml");
   }();
+  return s;
+}
+
+/// Each step's name, converged flag and stop reason, for a failed expectation's message.
+inline std::string step_stops(const RegistrationResult& r) {
+  std::string s;
+  for (const auto& rep : r.reports) s += rep.name + (rep.converged ? " (converged): " : " (not converged): ") + rep.stop_reason + "\n";
   return s;
 }
 

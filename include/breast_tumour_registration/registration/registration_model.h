@@ -31,6 +31,11 @@ struct StepReport {
   double gradient_norm = 0;
   double projection_rms_change = 0;  ///< surface step: RMS motion of the held skin between the last two projections [m]
   double projection_max_change = 0;  ///< surface step: the largest such motion [m]
+  /// surface step: the contraction of the alternation measured over the last iterates, the
+  /// skin's estimated RMS distance from its fixed point at the end [m] (infinite: not
+  /// contracting), and the projections that took an Anderson-accelerated iterate
+  double contraction = 0, fixed_point_distance = 0;
+  int accelerated_projections = 0;
   /// surface step: skin vertices constrained by the last projection (the others were too
   /// far from the supine surface or projected onto its border) and all skin vertices
   int constrained_skin = 0, skin_vertices = 0;

@@ -3,7 +3,8 @@
 // soft point (eq. 4.2) and point-to-plane (eq. 4.3) springs hold them there while the
 // interior follows; the chest wall is fixed by eliminating its DOFs, so every system is
 // symmetric positive definite (the thesis solves a KKT system with LU instead). Projection
-// and Newton alternate until the projections stop moving.
+// and Newton alternate (Anderson-accelerated) until the skin is estimated to be within the
+// tolerance of the alternation's fixed point.
 #pragma once
 
 #include "breast_tumour_registration/geometry/anchor.h"
@@ -22,12 +23,22 @@ struct SurfaceStepOptions {
   /// not converged, with the last change of the projections.
   int max_projections = 40;
   int newton_per_projection = 1; ///< Newton iterations between projections (thesis: 1)
-  /// [m] Convergence: the held skin moved less than this (RMS) since the previous projection,
-  /// then Newton on the settled projections meets its gradient criterion (up to
-  /// newton.max_iterations). The skin's motion, not the projections' change: on a noisy scan
-  /// the projections jitter along the surface while the skin stays put.
+  /// [m] Convergence: the held skin's estimated RMS distance from the fixed point of the
+  /// projection/Newton alternation, |G(x) - x| / (1 - q) with q the rate at which that
+  /// residual falls (the larger of its last two ratios), is below this, or the alternation
+  /// reached its floor (floor_projections); then Newton on the settled projections meets
+  /// its gradient criterion (up to newton.max_iterations). Not the last step alone: on soft
+  /// tissue q is 0.8 to 0.9, and a step of 0.1 mm left the skin about 0.5 mm from where it
+  /// was going (BENCHMARKS.md, issue 10).
   double projection_tolerance = 2e-5;
-  /// A stall: the skin's motion between projections has not reached a new low for this many
+  /// Anderson acceleration of the alternation (anderson_acceleration.h): the last this many
+  /// differences, a proposal kept only where it lowers the energy; 0: the thesis's plain iteration.
+  int anderson_depth = 5;
+  /// The alternation's floor: the skin's motion per projection has not reached a new low for
+  /// this many projections and was at most the tolerance over them (a polyhedral
+  /// surface leaves a jitter of a few hundredths of a millimetre): converged, and reported so.
+  int floor_projections = 4;
+  /// A stall: the skin's motion per projection has not reached a new low for this many
   /// projections (reported as not converged).
   int stall_projections = 8;
   /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
