@@ -1,5 +1,8 @@
 #include "breast_tumour_registration/geometry/organized_cloud.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -47,6 +50,62 @@ Points finite_points(const Points& cloud) {
     if (cloud.row(i).allFinite()) out.row(k++) = cloud.row(i);
   out.conservativeResize(k, 3);
   return out;
+}
+
+Points smooth_organized(const Points& cloud, int width, int height, double sigma_pixels, double max_edge) {
+  if (width <= 0 || height <= 0 || cloud.rows() != static_cast<Eigen::Index>(width) * height)
+    throw InputError("smoothing an organized cloud: " + std::to_string(cloud.rows()) + " points are not " + std::to_string(width) +
+                     " x " + std::to_string(height) + " pixels");
+  if (!(sigma_pixels > 0)) return cloud;
+  const int radius = static_cast<int>(std::ceil(3 * sigma_pixels));
+  std::vector<double> w(static_cast<size_t>(radius) + 1);
+  for (int d = 0; d <= radius; ++d) w[static_cast<size_t>(d)] = std::exp(-0.5 * d * d / (sigma_pixels * sigma_pixels));
+  const double edge_sq = max_edge * max_edge;
+  auto valid = [&](Eigen::Index i) { return cloud.row(i).allFinite(); };
+  Points out = cloud;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const Eigen::Index i = static_cast<Eigen::Index>(v) * width + u;
+      if (!valid(i)) continue;
+      const Eigen::RowVector3d p = cloud.row(i);
+      Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+      double total = 0;
+      for (int dv = -radius; dv <= radius; ++dv) {
+        const int vv = v + dv;
+        if (vv < 0 || vv >= height) continue;
+        for (int du = -radius; du <= radius; ++du) {
+          const int uu = u + du;
+          if (uu < 0 || uu >= width) continue;
+          const Eigen::Index j = static_cast<Eigen::Index>(vv) * width + uu;
+          if (!valid(j) || (cloud.row(j) - p).squaredNorm() > edge_sq) continue;
+          const double wj = w[static_cast<size_t>(std::abs(du))] * w[static_cast<size_t>(std::abs(dv))];
+          sum += wj * (cloud.row(j) - p);  // about p: no cancellation far from the origin
+          total += wj;
+        }
+      }
+      out.row(i) = p + sum / total;
+    }
+  }
+  return out;
+}
+
+double estimate_organized_noise(const Points& cloud, int width, int height, double max_edge) {
+  if (width <= 0 || height <= 0 || cloud.rows() != static_cast<Eigen::Index>(width) * height)
+    throw InputError("estimating an organized cloud's noise: " + std::to_string(cloud.rows()) + " points are not " +
+                     std::to_string(width) + " x " + std::to_string(height) + " pixels");
+  std::vector<double> r;
+  const double edge_sq = max_edge * max_edge;
+  for (int v = 0; v < height; ++v)
+    for (int u = 1; u + 1 < width; ++u) {
+      const Eigen::Index i = static_cast<Eigen::Index>(v) * width + u;
+      const auto a = cloud.row(i - 1), b = cloud.row(i), c = cloud.row(i + 1);
+      if (!a.allFinite() || !b.allFinite() || !c.allFinite() || (a - b).squaredNorm() > edge_sq || (c - b).squaredNorm() > edge_sq)
+        continue;
+      r.push_back((b - 0.5 * (a + c)).norm());
+    }
+  if (r.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2), r.end());
+  return 1.4826 * r[r.size() / 2] / std::sqrt(1.5);
 }
 
 }  // namespace btr

@@ -1,5 +1,8 @@
 #include "breast_tumour_registration/registration/live_scene.h"
 
+#include <cmath>
+#include <limits>
+
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/organized_cloud.h"
 
@@ -9,7 +12,14 @@ LiveScene live_scene(const Scene& prepared, const LiveScan& scan, const LiveScen
   LiveScene live{prepared, scan.supine_to_working.inverse()};
   Scene& s = live.scene;
   if (scan.width > 0) {
-    s.supine_surface = triangulate_organized(scan.cloud, scan.width, scan.height, opt.max_depth_edge);
+    const bool organized = scan.height > 0 && scan.cloud.rows() == static_cast<Eigen::Index>(scan.width) * scan.height;
+    const double noise = organized ? estimate_organized_noise(scan.cloud, scan.width, scan.height, opt.max_depth_edge)
+                                   : std::numeric_limits<double>::quiet_NaN();  // triangulate_organized says why
+    live.estimated_noise = std::isfinite(noise) ? noise : 0.0;
+    live.smoothed = opt.smoothing_pixels > 0 && live.estimated_noise > opt.smoothing_min_noise;
+    s.supine_surface = triangulate_organized(
+        live.smoothed ? smooth_organized(scan.cloud, scan.width, scan.height, opt.smoothing_pixels, opt.max_depth_edge) : scan.cloud,
+        scan.width, scan.height, opt.max_depth_edge);
     s.supine_cloud.reset();
   } else {
     Points finite = finite_points(scan.cloud);

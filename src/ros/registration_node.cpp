@@ -60,6 +60,7 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   read_param(pnh, "icp_max_iterations", p.icp_max_iterations, "an integer");
   read_param(pnh, "icp_max_correspondence", p.icp_max_correspondence, "a number [m]");
   read_param(pnh, "max_depth_edge", p.max_depth_edge, "a number [m]");
+  read_param(pnh, "scan_smoothing_pixels", p.scan_smoothing_pixels, "a number [px]");
   read_param(pnh, "use_landmarks", p.use_landmarks, "true or false");
   read_param(pnh, "min_tracked_clouds", p.min_tracked_clouds, "an integer");
   read_param(pnh, "rigid_margin", p.rigid_margin, "a number [m]");
@@ -75,8 +76,9 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   }
   preset_options(p.preset);  // throws for an unknown preset
   if (!(p.voxel_size >= 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
-      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0) || p.smoothing_clouds < 1)
-    throw InputError("parameters ~icp_max_correspondence, ~max_depth_edge must be > 0, ~voxel_size and "
+      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0) || p.smoothing_clouds < 1 ||
+      !(p.scan_smoothing_pixels >= 0 && p.scan_smoothing_pixels <= 50))
+    throw InputError("parameters ~icp_max_correspondence, ~max_depth_edge must be > 0, ~scan_smoothing_pixels in [0, 50], ~voxel_size and "
                      "~rigid_margin >= 0, and ~icp_every_n, ~icp_max_iterations, ~min_tracked_clouds, "
                      "~smoothing_clouds >= 1");
   if ((p.roi_max - p.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
@@ -284,6 +286,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
         throw NotReady("the depth tracking is settling (" + std::to_string(tracked) + " of " +
                        std::to_string(params_.min_tracked_clouds) + " consecutive clouds aligned); call again shortly");
       lo.max_depth_edge = params_.max_depth_edge;
+      lo.smoothing_pixels = params_.scan_smoothing_pixels;
       lo.use_landmarks = params_.use_landmarks;
       scan = LiveScan{std::move(cloud), w, h, *T};
     }

@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
           "points:=/camera/depth/points [_param:=value ...]\n"
           "Parameters (README, section ROS): ~scene, ~working_frame, ~model_frame, ~preset, ~voxel_size,\n"
           "~icp_every_n, ~icp_max_iterations, ~icp_max_correspondence, ~initial_model_pose, ~roi_min, ~roi_max,\n"
-          "~max_depth_edge, ~use_landmarks, ~min_tracked_clouds, ~rigid_margin, ~smoothing_clouds.\n"
+          "~max_depth_edge, ~scan_smoothing_pixels, ~use_landmarks, ~min_tracked_clouds, ~rigid_margin, ~smoothing_clouds.\n"
           "Service ~register; topics ~result, ~status, ~tumour_mesh, ~tumour_marker, ~breast_marker; tf.\n");
       return 0;
     }

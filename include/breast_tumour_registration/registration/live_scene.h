@@ -17,11 +17,20 @@ struct LiveScan {
 struct LiveSceneOptions {
   double max_depth_edge = 0.01;  ///< [m] no triangle across a longer edge (depth discontinuities)
   bool use_landmarks = true;     ///< keep the scene's supine landmarks (moved into the working frame)
+  /// An organized scan whose estimated depth noise (estimate_organized_noise) exceeds
+  /// smoothing_min_noise [m] is smoothed in its image grid first (smooth_organized, Gaussian
+  /// sigma in pixels; 0: never): the surface step projects onto it, and a depth camera's
+  /// per-pixel noise otherwise keeps the skin sliding (BENCHMARKS.md, issue 10). A scan without
+  /// measurable noise is left as it is: there the smoothing only costs accuracy.
+  double smoothing_pixels = 2.0;
+  double smoothing_min_noise = 2e-4;
 };
 
 struct LiveScene {
   Scene scene;                  ///< supine side in the working frame; automatic steps
   Rigid known_supine_to_model;  ///< for RegistrationOptions::known_supine_to_model: the tracked pose decides
+  double estimated_noise = 0;   ///< [m] an organized scan's estimated depth noise (0: not organized)
+  bool smoothed = false;        ///< the scan was smoothed before triangulation
 };
 
 /// The scene to register against the scan: an organized cloud is triangulated (the surface

@@ -36,6 +36,7 @@ struct NodeParameters {
   double icp_max_correspondence = 0.01;   ///< ~icp_max_correspondence [m]
   Rigid initial_model_pose = Rigid::Identity();  ///< ~initial_model_pose [x y z roll pitch yaw], working frame
   double max_depth_edge = 0.01;           ///< ~max_depth_edge [m]: no surface across depth jumps
+  double scan_smoothing_pixels = 2.0;     ///< ~scan_smoothing_pixels: Gaussian sigma of the scan's smoothing before registration (0: none)
   bool use_landmarks = true;              ///< ~use_landmarks with the live cloud
   int min_tracked_clouds = 10;            ///< ~min_tracked_clouds: consecutive ICP successes before registering
   double rigid_margin = 0.015;            ///< ~rigid_margin [m]: track chest-ring points this far from the breast
