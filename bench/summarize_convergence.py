@@ -21,10 +21,10 @@ for arg in sys.argv[1:]:
     total = bad = 0
     for E in sorted(by_e):
         rows = by_e[E]
-        nc = [v for k, v in rows if not v[1].startswith("converged")]
-        for v in nc:
-            why = re.sub(r"[-0-9.e]+ ?(mm|N|s)?", "#", v[1].split(": ", 1)[-1])[:70]
-            reasons[(name, why)] += 1
+        nc = [(k, v) for k, v in rows if not v[1].startswith("converged")]
+        for k, v in nc:
+            why = re.sub(r"-?\d[\d.]*(e[-+]?\d+)?", "#", v[1].split(": ", 1)[-1])[:90]
+            reasons[(name, k[0] + "/" + k[1], why)] += 1
         full = [v[0] for k, v in rows if k[0] == "practical" and k[1] == "full"]
         worst = sorted(v[0] for k, v in rows)
         med = worst[len(worst) // 2] if worst else float("nan")
@@ -34,5 +34,5 @@ for arg in sys.argv[1:]:
     print(f"| {name} | all | {total} | {bad} ({100.0 * bad / max(total, 1):.0f} %) | | |")
 print()
 print("Not converged, by reason (numbers replaced by #):")
-for (name, why), n in sorted(reasons.items(), key=lambda t: -t[1]):
-    print(f"- {name}: {n} x {why}")
+for (name, run, why), n in sorted(reasons.items(), key=lambda t: -t[1]):
+    print(f"- {name}, {run}: {n} x {why}")

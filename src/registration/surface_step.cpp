@@ -116,6 +116,12 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   bool finished = false;  // the loop ended for a reason of its own, not on the cap
   double least_residual = std::numeric_limits<double>::infinity();
   int least_at = 0;
+  // The first state whose step fell below the tolerance (where the thesis's criterion, and this
+  // step's before issue 10, stopped): kept, and returned if going on to the fixed point fails
+  // (a fold, a stall, the cap), so that the stricter criterion never leaves a worse answer.
+  Points fallback;
+  int fallback_at = 0;
+  bool aborted = false;
   std::vector<double> residuals;  // per projection [m]
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
     if (callback) nopt.callback = [&](const IterationInfo& it) {
@@ -136,6 +142,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.stop_reason = to_string(r.reason);
     finished = true;
     if (r.reason == StopReason::Aborted) {
+      aborted = true;
       x = g;
       break;
     }
@@ -163,6 +170,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     for (int i : held) rep.projection_max_change = std::max(rep.projection_max_change, (g.row(model.skin[static_cast<size_t>(i)]) - x.row(model.skin[static_cast<size_t>(i)])).norm());
     rep.contraction = q_hat;
     rep.fixed_point_distance = distance;
+    if (fallback_at == 0 && outer > 1 && residual <= opt.projection_tolerance) {
+      fallback = g;
+      fallback_at = outer;
+    }
     // The alternation's floor: on a polyhedral surface the closest points switch between
     // faces, and the skin ends jittering by a few hundredths of a millimetre per projection
     // without a contraction to measure. When the residual has not reached a new low for
@@ -195,7 +206,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                                             " mm RMS per projection at most over the last " + std::to_string(opt.floor_projections + 1) +
                                             " projections)";
       rep.stop_reason = r.converged ? how + " and the gradient criterion held"
-                                    : how + " but Newton reached its iteration cap (" + to_string(r.reason) + ")";
+                        : r.reason == StopReason::MaxIterations
+                            ? how + " but Newton reached its iteration cap (gradient " + std::to_string(r.gradient_norm) + " N)"
+                            : how + " but Newton on those projections stopped: " + to_string(r.reason) + " (gradient " +
+                                  std::to_string(r.gradient_norm) + " N)";
       x = g;
       break;
     }
@@ -254,6 +268,20 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                       std::to_string(rep.projection_rms_change * 1e3) + " mm RMS per projection (estimated " +
                       (std::isfinite(rep.fixed_point_distance) ? std::to_string(rep.fixed_point_distance * 1e3) + " mm" : std::string("an unknown distance")) +
                       " from the fixed point; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm)";
+  if (!rep.converged && !aborted && fallback_at > 0) {
+    x = fallback;
+    rep.constrained_skin = project_at(x, true);
+    nopt.max_iterations = std::max(opt.newton_per_projection, opt.newton.max_iterations);
+    const NewtonResult r = solver.solve(energy, x, nopt);
+    rep.add_newton_profile(r);
+    rep.iterations += r.iterations;
+    rep.energy = r.energy;
+    rep.gradient_norm = r.gradient_norm;
+    rep.stop_reason += "; kept the state of projection " + std::to_string(fallback_at) +
+                       ", where the skin first moved less than the tolerance per projection (Newton there: " + to_string(r.reason) + ")";
+    rep.note = "the surface step did not reach its fixed point; the result is the state where the skin first moved less than " +
+               std::to_string(opt.projection_tolerance * 1e3) + " mm per projection";
+  }
   if (pose) *pose = free_springs->size() >= 3 ? free_springs->pose(x) : P;
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;

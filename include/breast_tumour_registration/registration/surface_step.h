@@ -32,8 +32,11 @@ struct SurfaceStepOptions {
   /// was going (BENCHMARKS.md, issue 10).
   double projection_tolerance = 2e-5;
   /// Anderson acceleration of the alternation (anderson_acceleration.h): the last this many
-  /// differences, a proposal kept only where it lowers the energy; 0: the thesis's plain iteration.
-  int anderson_depth = 5;
+  /// differences, a proposal kept only where it lowers the energy; 0: the thesis's plain
+  /// iteration. Off by default: it took 2 to 3 times fewer projections on the phantom, but on
+  /// the TetGen body at 1000 Pa (pose free) it led the skin into a fold, 6.6 mm off where the
+  /// plain iteration converges at 2.8 mm (BENCHMARKS.md, issue 10).
+  int anderson_depth = 0;
   /// The alternation's floor: the skin's motion per projection has not reached a new low for
   /// this many projections and was at most the tolerance over them (a polyhedral
   /// surface leaves a jitter of a few hundredths of a millimetre): converged, and reported so.
