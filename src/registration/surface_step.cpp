@@ -121,6 +121,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   // (a fold, a stall, the cap), so that the stricter criterion never leaves a worse answer.
   Points fallback;
   int fallback_at = 0;
+  long fallback_inverted = 0;
+  const long inverted_start = count_inverted(x, model.rest.T);
   bool aborted = false;
   std::vector<double> residuals;  // per projection [m]
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
@@ -173,6 +175,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     if (fallback_at == 0 && outer > 1 && residual <= opt.projection_tolerance) {
       fallback = g;
       fallback_at = outer;
+      fallback_inverted = r.inverted;
     }
     // The alternation's floor: on a polyhedral surface the closest points switch between
     // faces, and the skin ends jittering by a few hundredths of a millimetre per projection
@@ -268,17 +271,31 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                       std::to_string(rep.projection_rms_change * 1e3) + " mm RMS per projection (estimated " +
                       (std::isfinite(rep.fixed_point_distance) ? std::to_string(rep.fixed_point_distance * 1e3) + " mm" : std::string("an unknown distance")) +
                       " from the fixed point; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm)";
+  // A limit that inverts elements the state at the step's start did not have is no answer
+  // either: the earlier state is kept when it has fewer.
+  const long inverted_end = count_inverted(x, model.rest.T);
+  if (rep.converged && fallback_at > 0 && inverted_end > inverted_start && fallback_inverted < inverted_end) {
+    rep.converged = false;
+    rep.stop_reason += ", but " + std::to_string(inverted_end) + " tetrahedra ended inverted";
+  }
   if (!rep.converged && !aborted && fallback_at > 0) {
     x = fallback;
     rep.constrained_skin = project_at(x, true);
     nopt.max_iterations = std::max(opt.newton_per_projection, opt.newton.max_iterations);
+    const long inverted_there = count_inverted(x, model.rest.T);
     const NewtonResult r = solver.solve(energy, x, nopt);
     rep.add_newton_profile(r);
     rep.iterations += r.iterations;
-    rep.energy = r.energy;
+    std::string there = to_string(r.reason);
+    if (r.inverted > inverted_there) {  // a stall that was let invert: that state as it was instead
+      x = fallback;
+      rep.inverted = inverted_there;
+      there += "; it inverted elements, so the state is kept without it";
+    }
+    rep.energy = energy.value(x);
     rep.gradient_norm = r.gradient_norm;
     rep.stop_reason += "; kept the state of projection " + std::to_string(fallback_at) +
-                       ", where the skin first moved less than the tolerance per projection (Newton there: " + to_string(r.reason) + ")";
+                       ", where the skin first moved less than the tolerance per projection (Newton there: " + there + ")";
     rep.note = "the surface step did not reach its fixed point; the result is the state where the skin first moved less than " +
                std::to_string(opt.projection_tolerance * 1e3) + " mm per projection";
   }

@@ -81,7 +81,7 @@ TEST_P(PipelineMaterial, FiniteAndStillClose) {
     s.material.poisson_ratio = nu;
   });
   expect_finite(o);
-  EXPECT_EQ(o.inverted, 0);
+  EXPECT_EQ(o.inverted, 0) << btr::test::step_stops(o.r);
   // The constraints dominate the material: a wrong E keeps the tumour within 2 mm, or the
   // pipeline says that it did not converge (the CLI's exit code 4); never a silent miss.
   EXPECT_TRUE(worst(o) < 2e-3 || !o.r.converged) << "E " << E << " nu " << nu << ": " << worst(o) * 1e3 << " mm";
