@@ -70,6 +70,11 @@ int main(int argc, char** argv) {
       scan.cloud = transform_points(camera, noisy);  // the scene's supine frame is the working frame
       scan.width = cam.width;
       scan.height = cam.height;
+      if (k == 0) {
+        const LiveScene probe = live_scene(scene, scan, live);
+        std::printf("estimated depth noise of scan 0: %.3f mm (%s)\n", probe.estimated_noise * 1e3,
+                    probe.smoothed ? "smoothed" : "not smoothed");
+      }
       const auto t0 = std::chrono::steady_clock::now();
       const RegistrationResult r = engine.solve_live(scan, live, opt);
       seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
