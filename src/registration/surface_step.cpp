@@ -4,6 +4,7 @@
 #include <limits>
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/anderson_acceleration.h"
@@ -91,11 +92,15 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                        " m of the supine surface; is the scan aligned with the model?");
     return static_cast<int>(kept);
   };
-  // RMS over the held skin of the rows of a - b [m].
-  auto held_rms = [&](const Points& a, const Points& b) {
-    double s = 0;
-    for (int i : held) s += (a.row(model.skin[static_cast<size_t>(i)]) - b.row(model.skin[static_cast<size_t>(i)])).squaredNorm();
-    return held.empty() ? 0.0 : std::sqrt(s / static_cast<double>(held.size()));
+  // RMS and largest norm over the held skin of the rows of a - b [m].
+  auto held_change = [&](const Points& a, const Points& b) {
+    double s = 0, largest = 0;
+    for (int i : held) {
+      const double d = (a.row(model.skin[static_cast<size_t>(i)]) - b.row(model.skin[static_cast<size_t>(i)])).norm();
+      s += d * d;
+      largest = std::max(largest, d);
+    }
+    return std::make_pair(held.empty() ? 0.0 : std::sqrt(s / static_cast<double>(held.size())), largest);
   };
 
   // The fixed-point iteration x <- G(x): project the skin of x, one Newton step on those
@@ -110,7 +115,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   if (opt.anderson_depth > 0) aa = std::make_unique<AndersonAcceleration>(opt.anderson_depth);
   rep.constrained_skin = project_at(x, false);
   double merit = energy.value(x);
-  long inverted_now = count_inverted(x, model.rest.T);
+  const long inverted_start = count_inverted(x, model.rest.T);
+  long inverted_now = inverted_start;
   Points g;
   int offset = 0;
   bool finished = false;  // the loop ended for a reason of its own, not on the cap
@@ -122,7 +128,6 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   Points fallback;
   int fallback_at = 0;
   long fallback_inverted = 0;
-  const long inverted_start = count_inverted(x, model.rest.T);
   bool aborted = false;
   std::vector<double> residuals;  // per projection [m]
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
@@ -156,7 +161,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // The fixed-point residual and the contraction between this iterate and the last; the
     // bound needs two contraction estimates (the first step, from the landmark step's state,
     // contracts far more than the slow tangential relaxation after it).
-    const double residual = held_rms(g, x);
+    const auto [residual, largest_change] = held_change(g, x);
     residuals.push_back(residual);
     // The contraction: the larger of the last two residual ratios (cautious; NaN until both
     // exist). For the plain iteration it is the map's contraction; with Anderson's iterates the
@@ -168,8 +173,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     }
     const double distance = q_hat < 1 ? residual / (1 - q_hat) : std::numeric_limits<double>::infinity();
     rep.projection_rms_change = residual;
-    rep.projection_max_change = 0;
-    for (int i : held) rep.projection_max_change = std::max(rep.projection_max_change, (g.row(model.skin[static_cast<size_t>(i)]) - x.row(model.skin[static_cast<size_t>(i)])).norm());
+    rep.projection_max_change = largest_change;
     rep.contraction = q_hat;
     rep.fixed_point_distance = distance;
     if (fallback_at == 0 && outer > 1 && residual <= opt.projection_tolerance) {
@@ -273,10 +277,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                       " from the fixed point; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm)";
   // A limit that inverts elements the state at the step's start did not have is no answer
   // either: the earlier state is kept when it has fewer.
-  const long inverted_end = count_inverted(x, model.rest.T);
-  if (rep.converged && fallback_at > 0 && inverted_end > inverted_start && fallback_inverted < inverted_end) {
+  // (x is the last Newton's result on every exit, so its count is rep.inverted.)
+  if (rep.converged && fallback_at > 0 && rep.inverted > inverted_start && fallback_inverted < rep.inverted) {
     rep.converged = false;
-    rep.stop_reason += ", but " + std::to_string(inverted_end) + " tetrahedra ended inverted";
+    rep.stop_reason += ", but " + std::to_string(rep.inverted) + " tetrahedra ended inverted";
   }
   if (!rep.converged && !aborted && fallback_at > 0) {
     x = fallback;
