@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -52,21 +53,34 @@ Points finite_points(const Points& cloud) {
   return out;
 }
 
+bool is_organized(const Points& cloud, int width, int height) {
+  return width > 0 && height > 0 && cloud.rows() == static_cast<Eigen::Index>(width) * height;
+}
+
+namespace {
+
+void require_organized(const Points& cloud, int width, int height, const std::string& what) {
+  if (!is_organized(cloud, width, height))
+    throw InputError(what + ": " + std::to_string(cloud.rows()) + " points are not " + std::to_string(width) + " x " +
+                     std::to_string(height) + " pixels");
+}
+
+}  // namespace
+
 Points smooth_organized(const Points& cloud, int width, int height, double sigma_pixels, double max_edge) {
-  if (width <= 0 || height <= 0 || cloud.rows() != static_cast<Eigen::Index>(width) * height)
-    throw InputError("smoothing an organized cloud: " + std::to_string(cloud.rows()) + " points are not " + std::to_string(width) +
-                     " x " + std::to_string(height) + " pixels");
+  require_organized(cloud, width, height, "smoothing an organized cloud");
   if (!(sigma_pixels > 0)) return cloud;
   const int radius = static_cast<int>(std::ceil(3 * sigma_pixels));
   std::vector<double> w(static_cast<size_t>(radius) + 1);
   for (int d = 0; d <= radius; ++d) w[static_cast<size_t>(d)] = std::exp(-0.5 * d * d / (sigma_pixels * sigma_pixels));
   const double edge_sq = max_edge * max_edge;
-  auto valid = [&](Eigen::Index i) { return cloud.row(i).allFinite(); };
+  std::vector<char> valid(static_cast<size_t>(cloud.rows()));  // once, not per neighbour
+  for (Eigen::Index i = 0; i < cloud.rows(); ++i) valid[static_cast<size_t>(i)] = cloud.row(i).allFinite();
   Points out = cloud;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       const Eigen::Index i = static_cast<Eigen::Index>(v) * width + u;
-      if (!valid(i)) continue;
+      if (!valid[static_cast<size_t>(i)]) continue;
       const Eigen::RowVector3d p = cloud.row(i);
       Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
       double total = 0;
@@ -77,7 +91,7 @@ Points smooth_organized(const Points& cloud, int width, int height, double sigma
           const int uu = u + du;
           if (uu < 0 || uu >= width) continue;
           const Eigen::Index j = static_cast<Eigen::Index>(vv) * width + uu;
-          if (!valid(j) || (cloud.row(j) - p).squaredNorm() > edge_sq) continue;
+          if (!valid[static_cast<size_t>(j)] || (cloud.row(j) - p).squaredNorm() > edge_sq) continue;
           const double wj = w[static_cast<size_t>(std::abs(du))] * w[static_cast<size_t>(std::abs(dv))];
           sum += wj * (cloud.row(j) - p);  // about p: no cancellation far from the origin
           total += wj;
@@ -90,9 +104,7 @@ Points smooth_organized(const Points& cloud, int width, int height, double sigma
 }
 
 double estimate_organized_noise(const Points& cloud, int width, int height, double max_edge) {
-  if (width <= 0 || height <= 0 || cloud.rows() != static_cast<Eigen::Index>(width) * height)
-    throw InputError("estimating an organized cloud's noise: " + std::to_string(cloud.rows()) + " points are not " +
-                     std::to_string(width) + " x " + std::to_string(height) + " pixels");
+  require_organized(cloud, width, height, "estimating an organized cloud's noise");
   std::vector<double> r;
   const double edge_sq = max_edge * max_edge;
   for (int v = 0; v < height; ++v)

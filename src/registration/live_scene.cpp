@@ -12,8 +12,7 @@ LiveScene live_scene(const Scene& prepared, const LiveScan& scan, const LiveScen
   LiveScene live{prepared, scan.supine_to_working.inverse()};
   Scene& s = live.scene;
   if (scan.width > 0) {
-    const bool organized = scan.height > 0 && scan.cloud.rows() == static_cast<Eigen::Index>(scan.width) * scan.height;
-    const double noise = organized ? estimate_organized_noise(scan.cloud, scan.width, scan.height, opt.max_depth_edge)
+    const double noise = is_organized(scan.cloud, scan.width, scan.height) ? estimate_organized_noise(scan.cloud, scan.width, scan.height, opt.max_depth_edge)
                                    : std::numeric_limits<double>::quiet_NaN();  // triangulate_organized says why
     live.estimated_noise = std::isfinite(noise) ? noise : 0.0;
     live.smoothed = opt.smoothing_pixels > 0 && live.estimated_noise > opt.smoothing_min_noise;

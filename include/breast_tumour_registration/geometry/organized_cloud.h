@@ -13,6 +13,9 @@ namespace btr {
 /// when the cloud is not organized (rows != width * height) or yields no face.
 SurfaceMesh triangulate_organized(const Points& cloud, int width, int height, double max_edge = 0.01);
 
+/// Whether `cloud` has one row per pixel of a width x height image (both > 0).
+bool is_organized(const Points& cloud, int width, int height);
+
 /// An organized cloud denoised in its image grid: each valid pixel becomes the Gaussian-weighted
 /// mean (sigma `sigma_pixels`, window 3 sigma) of the valid pixels around it that lie within
 /// `max_edge` [m] of it (no averaging across depth discontinuities). A depth camera's noise is
