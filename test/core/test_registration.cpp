@@ -24,19 +24,8 @@ using btr::test::make_rigid;
 
 namespace {
 
-// One coarse phantom scene (2.2k tetrahedra, E = 3400 Pa) shared by the tests.
-const std::string& phantom_dir() {
-  static const std::string dir = [] {
-    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12").string();
-    std::filesystem::remove_all(d);
-    PhantomSceneOptions o;
-    o.phantom.tet.cell_size = 0.012;
-    o.phantom.surface_rings = 12;
-    write_phantom_scene(d, o);
-    return d;
-  }();
-  return dir;
-}
+// The shared coarse phantom scene (2.2k tetrahedra, E = 3400 Pa) and its folder.
+const std::string& phantom_dir() { return btr::test::coarse_phantom_dir(); }
 
 std::string phantom_scene_text(const std::string& base = phantom_dir()) { return btr::test::scene_text(base); }
 using btr::test::without_key;

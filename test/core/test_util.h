@@ -28,16 +28,22 @@ inline std::string temp_dir() {
 
 /// One coarse phantom scene (12 mm cells, 12 surface rings, E = 3400 Pa, 2.2k tetrahedra),
 /// written once per test process and loaded; shared by the tests that only read it.
-inline const Scene& coarse_phantom_scene() {
-  static const Scene s = [] {
-    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12_shared").string();
+/// Its folder (tests may add scene variants beside scene.yaml, never change it) and the scene.
+inline const std::string& coarse_phantom_dir() {
+  static const std::string dir = [] {
+    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12").string();
     std::filesystem::remove_all(d);
     PhantomSceneOptions o;
     o.phantom.tet.cell_size = 0.012;
     o.phantom.surface_rings = 12;
     write_phantom_scene(d, o);
-    return load_scene(d + "/scene.yaml");
+    return d;
   }();
+  return dir;
+}
+
+inline const Scene& coarse_phantom_scene() {
+  static const Scene s = load_scene(coarse_phantom_dir() + "/scene.yaml");
   return s;
 }
 
