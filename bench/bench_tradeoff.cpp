@@ -55,7 +55,7 @@ int main(int argc, char** argv) {
   app.add_option("--cell-sizes", cells, "simulation mesh cell sizes to sweep [mm]");
   app.add_option("-o,--out", out_path, "CSV file")->capture_default_str();
   std::vector<std::string> knobs;
-  app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance");
+  app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance target_normals");
   CLI11_PARSE(app, argc, argv);
   try {
     const Scene scene = load_scene(scene_path);
@@ -86,6 +86,11 @@ int main(int argc, char** argv) {
       for (int d : {0, 2, 5, 8}) {  // 0: the thesis's plain projection/Newton alternation
         Point p{"anderson_depth", std::to_string(d), "balanced", c, preset_options("balanced")};
         p.opt.surface.anderson_depth = d;
+        points.push_back(p);
+      }
+      for (const MeshNormals n : {MeshNormals::Face, MeshNormals::Interpolated}) {  // the point-to-plane springs' normal
+        Point p{"target_normals", n == MeshNormals::Face ? "face" : "interpolated", "balanced", c, preset_options("balanced")};
+        p.opt.surface.target_normals = n;
         points.push_back(p);
       }
       for (double tol : {4e-4, 2e-4, 1e-4, 5e-5, 2e-5}) {  // the surface step's distance to its fixed point [m]

@@ -10,13 +10,15 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/closest_point.h"
+#include "breast_tumour_registration/geometry/vertex_normals.h"
 
 namespace btr {
 namespace {
 
 class MeshProjector : public SurfaceProjector {
  public:
-  explicit MeshProjector(const SurfaceMesh& m) : cp_(m.V, m.F), V_(m.V), F_(m.F), border_(m.F.rows(), 0) {
+  MeshProjector(const SurfaceMesh& m, MeshNormals normals) : cp_(m.V, m.F), V_(m.V), F_(m.F), border_(m.F.rows(), 0) {
+    if (normals == MeshNormals::Interpolated) vertex_normals_ = vertex_normals(m);
     // Border edges: used by one triangle only. border_[f] bit k: the edge opposite corner k.
     std::map<std::pair<int, int>, int> uses;
     const auto edge = [&](Eigen::Index f, int k) {
@@ -32,6 +34,15 @@ class MeshProjector : public SurfaceProjector {
   Projection project(const Vec3& p) const override {
     const ClosestPoint c = cp_.query(p);
     Projection out{c.point, cp_.face_normal(c.face), c.distance, false};
+    if (vertex_normals_.rows()) {
+      Vec3 n = Vec3::Zero();
+      for (int k = 0; k < 3; ++k) n += c.barycentric[k] * vertex_normals_.row(F_(c.face, k)).transpose();
+      // Oriented as the face (vertex normals of an inconsistently oriented surface may not be);
+      // a blend that cancels out (a fold's crease) keeps the face normal.
+      if (n.dot(out.normal) < 0) n = -n;
+      const double len = n.norm();
+      if (len > 1e-6) out.normal = n / len;
+    }
     if (border_[c.face]) {
       for (int k = 0; k < 3 && !out.on_boundary; ++k) {
         if (!(border_[c.face] & (1 << k))) continue;
@@ -49,6 +60,7 @@ class MeshProjector : public SurfaceProjector {
   Points V_;
   Triangles F_;
   std::vector<unsigned char> border_;
+  Points vertex_normals_;  // #V by 3 for MeshNormals::Interpolated, else empty
 };
 
 class CloudProjector : public SurfaceProjector {
@@ -99,8 +111,8 @@ class CloudProjector : public SurfaceProjector {
 
 }  // namespace
 
-std::unique_ptr<SurfaceProjector> make_mesh_projector(const SurfaceMesh& mesh) {
-  return std::make_unique<MeshProjector>(mesh);
+std::unique_ptr<SurfaceProjector> make_mesh_projector(const SurfaceMesh& mesh, MeshNormals normals) {
+  return std::make_unique<MeshProjector>(mesh, normals);
 }
 
 std::unique_ptr<SurfaceProjector> make_cloud_projector(const Points& cloud, int neighbours) {

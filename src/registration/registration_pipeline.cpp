@@ -320,7 +320,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   // The supine surface in the model frame as the rigid step left it, as a projector (AABB
   // tree or kd-tree + normals), built once for the surface step and the skin-distance figure.
   std::unique_ptr<SurfaceProjector> supine;
-  if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface));
+  if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface), opt.surface.target_normals);
   else if (scene.supine_cloud) supine = make_cloud_projector(transform_points(T, *scene.supine_cloud));
 
   // 4. Surface-guided step; where the pose was estimated without a decisive rigid region, the

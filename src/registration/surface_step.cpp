@@ -303,6 +303,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.note = "the surface step did not reach its fixed point; the result is the state where the skin first moved less than " +
                std::to_string(opt.projection_tolerance * 1e3) + " mm per projection";
   }
+  rep.projection_residuals = residuals;
   if (pose) *pose = free_springs->size() >= 3 ? free_springs->pose(x) : P;
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;

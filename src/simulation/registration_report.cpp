@@ -93,7 +93,9 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
       << ", \"energy_J\": " << num(s.energy) << ", \"gradient_norm_N\": " << num(s.gradient_norm)
       << ", \"projection_rms_change_mm\": " << num(s.projection_rms_change * 1e3)
       << ", \"fixed_point_distance_mm\": " << num(s.fixed_point_distance * 1e3) << ", \"contraction\": " << num(s.contraction)
-      << ", \"accelerated_projections\": " << s.accelerated_projections
+      << ", \"accelerated_projections\": " << s.accelerated_projections << ", \"projection_rms_changes_mm\": [";
+    for (size_t k = 0; k < s.projection_residuals.size(); ++k) j << (k ? ", " : "") << num(s.projection_residuals[k] * 1e3);
+    j << "]"
       << ", \"constrained_skin_vertices\": " << s.constrained_skin << ", \"skin_vertices\": " << s.skin_vertices
       << ", \"inverted_tetrahedra\": " << s.inverted << ", \"inversions_allowed\": " << (s.inversions_allowed ? "true" : "false")
       << ",\n     \"profile_seconds\": {\"setup\": "

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -21,6 +22,7 @@
 using namespace btr;
 using btr::test::expect_throw_with;
 using btr::test::make_rigid;
+using btr::test::step_stops;
 
 namespace {
 
@@ -271,6 +273,43 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   expect_throw_with<InputError>(
       [&] { load_scene(scene_with("material: {youngs_modulus: 600, youngs_modulus_range: [100, 1000]}", "range_only", d)); },
       "only with 'youngs_modulus: estimate'");
+}
+
+// Issue 10: with face normals the point-to-plane springs jump wherever a skin vertex's closest
+// point crosses an edge of the supine mesh, so on soft tissue the alternation ended jittering at
+// about the balanced tolerance (0.1 mm per projection) and stalled. Vertex normals blended at
+// the closest point move the springs continuously: the alternation contracts to its fixed
+// point. On a soft phantom told its E and prone gravity that limit is the truth.
+TEST(SurfaceStep, InterpolatedNormalsContractToTheFixedPointOnASoftBreast) {
+  const std::string d = soft_phantom_dir("phantom12_soft_normals");
+  const Scene s = load_scene(scene_with("material: {youngs_modulus: 600, poisson_ratio: 0.49, density: 1000}\n"
+                                        "prone_gravity: [0, 0, 9.81]",
+                                        "soft_told", d));
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(s, warnings);
+  std::map<MeshNormals, RegistrationResult> r;
+  for (const MeshNormals n : {MeshNormals::Face, MeshNormals::Interpolated}) {
+    RegistrationOptions o = preset_options("balanced");
+    o.surface.target_normals = n;
+    r[n] = run_registration(s, m, o);
+  }
+  const RegistrationResult& smooth = r[MeshNormals::Interpolated];
+  const StepReport& surface = smooth.reports.back();
+  ASSERT_EQ(surface.name.rfind("surface", 0), 0u) << step_stops(smooth);
+  EXPECT_TRUE(surface.converged) << step_stops(smooth);
+  // Contracting: after the first two projections (the landmark step's state relaxing) the
+  // skin moves less at every projection.
+  const std::vector<double>& res = surface.projection_residuals;
+  ASSERT_GE(res.size(), 3u);
+  for (size_t k = 3; k < res.size(); ++k) EXPECT_LE(res[k], res[k - 1] * (1 + 1e-6)) << "projection " << k + 1;
+  const double face = worst_error(r[MeshNormals::Face]), blended = worst_error(smooth);
+  std::printf("600 Pa phantom told its E and gravity: worst tumour %.3f mm with face normals (%s), %.3f mm interpolated "
+              "(%zu projections)\n",
+              face * 1e3, r[MeshNormals::Face].converged ? "converged" : "not converged", blended * 1e3, res.size());
+  // Both normals leave the truth a fixed point; on this 12 mm mesh the two limits differ by
+  // hundredths of a millimetre (0.050 and 0.071 mm measured).
+  EXPECT_LT(std::abs(blended - face), 0.05e-3);
+  EXPECT_LT(blended, 0.15e-3);
 }
 
 // Issue 13: with the prone gravity given, the model's rest shape is the unloaded shape. On a
@@ -563,6 +602,48 @@ TEST(SurfaceProjector, FlagsClosestPointsOnTheBorderOfAnOpenSurface) {
   for (const Vec3& p : {Vec3(2, 0, 0), Vec3(0.1, 0.2, 0.3), Vec3(-1, 1, 1)}) EXPECT_FALSE(closed->project(p).on_boundary);
 }
 
+TEST(SurfaceProjector, InterpolatedNormalsAreContinuousAcrossEdgesAndCloserToTheSmoothSurface) {
+  // A coarse sphere (162 vertices): its face normals jump by about 14 deg across an edge.
+  const SurfaceMesh sphere = make_icosphere(Vec3::Zero(), 1.0, 2);
+  const auto face = make_mesh_projector(sphere, MeshNormals::Face);
+  const auto smooth = make_mesh_projector(sphere, MeshNormals::Interpolated);
+  // Two points on the surface 1e-6 from the edge shared by face 0 and its neighbour, one on
+  // each face (each its own closest point).
+  const Eigen::Vector3i f0 = sphere.F.row(0).transpose();
+  const Vec3 a = sphere.V.row(f0[0]), b = sphere.V.row(f0[1]), c = sphere.V.row(f0[2]);
+  int opposite = -1;  // the neighbour's third vertex
+  for (Eigen::Index f = 1; f < sphere.F.rows() && opposite < 0; ++f) {
+    int shared = 0, other = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (sphere.F(f, k) == f0[0] || sphere.F(f, k) == f0[1]) ++shared;
+      else other = sphere.F(f, k);
+    }
+    if (shared == 2) opposite = other;
+  }
+  ASSERT_GE(opposite, 0);
+  const Vec3 mid = 0.5 * (a + b);
+  const Vec3 p_in = mid + 1e-6 * (c - mid).normalized();
+  const Vec3 p_out = mid + 1e-6 * (Vec3(sphere.V.row(opposite).transpose()) - mid).normalized();
+  const double jump_face = face->project(p_in).normal.cross(face->project(p_out).normal).norm();
+  const double jump_smooth = smooth->project(p_in).normal.cross(smooth->project(p_out).normal).norm();
+  EXPECT_GT(jump_face, 0.1);       // sin of the dihedral angle
+  EXPECT_LT(jump_smooth, 1e-4);    // continuous
+  // Over many directions the blended normal is nearer the sphere's (radial) than the face's,
+  // points the same way as the face's, and the closest point is the same.
+  double err_face = 0, err_smooth = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 p = 1.3 * Vec3(std::sin(0.37 * i) * std::cos(1.1 * i), std::sin(0.37 * i) * std::sin(1.1 * i), std::cos(0.37 * i));
+    const Projection pf = face->project(p), ps = smooth->project(p);
+    EXPECT_NEAR((pf.point - ps.point).norm(), 0, 1e-12);
+    EXPECT_GT(pf.normal.dot(ps.normal), 0.9);
+    EXPECT_NEAR(ps.normal.norm(), 1, 1e-12);
+    const Vec3 radial = ps.point.normalized();
+    err_face += pf.normal.cross(radial).norm();
+    err_smooth += ps.normal.cross(radial).norm();
+  }
+  EXPECT_LT(err_smooth, 0.5 * err_face);
+}
+
 TEST(Registration, APartialScanIsNotPulledOntoItsBorder) {
   // The supine surface as a depth camera would leave it: one side of the breast missing.
   // Skin hidden from the scan must not be held to the scan's edge.
@@ -623,8 +704,7 @@ TEST(Landmarks, DuplicatesAreMergedAndHandlesCapped) {
 // Issue 10: without a rigid region the pose is solved with the deformation. On the phantom
 // with its chest ring removed, a scan misaligned by 15 deg / 10 mm must give the aligned
 // result, and the aligned scan must stay close to `steps: [landmarks, surface]` (which is
-// told the pose). Measured on this 12 mm phantom: 0.003 mm and 0.06 mm (BENCHMARKS.md has the
-// finer phantom across moduli).
+// told the pose). BENCHMARKS.md has the finer phantom across moduli.
 TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
   std::string text, line;
   std::istringstream is(phantom_scene_text());
@@ -641,13 +721,14 @@ TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
   EXPECT_TRUE(aligned.pose_solved_with_landmarks && aligned.pose_solved_with_surface && !aligned.icp_used);
   EXPECT_TRUE(aligned.converged && moved.converged);
   ASSERT_EQ(aligned.tumours.size(), moved.tumours.size());
-  // Each in its own supine frame, truth moved with the scan. Issue 10 asks for 0.5 mm; on this
-  // 12 mm mesh the skin ends at the surface step's jitter floor (about 0.03 mm per projection),
-  // where the two paths stop about 0.1 mm apart in tumour error (0.11 mm measured; the 6 mm
-  // mesh of BENCHMARKS.md's ring-free table is the finer check).
+  // Each in its own supine frame, truth moved with the scan. Issue 10 asks for 0.5 mm
+  // (misaligned against aligned) and 0.05 mm (aligned against told the pose). With face
+  // normals the skin ended at a jitter floor of about 0.03 mm per projection on this 12 mm mesh
+  // and the paths stopped 0.11 mm apart; with interpolated normals the three agree to 0.001 mm
+  // (0.145 mm each, measured).
   for (size_t i = 0; i < aligned.tumours.size(); ++i)
-    EXPECT_LT(std::abs(aligned.tumours[i].centroid_distance - moved.tumours[i].centroid_distance), 0.15e-3);
-  EXPECT_LT(worst_error(aligned), worst_error(told) + 0.15e-3) << worst_error(aligned) * 1e3 << " vs " << worst_error(told) * 1e3;
+    EXPECT_LT(std::abs(aligned.tumours[i].centroid_distance - moved.tumours[i].centroid_distance), 0.05e-3);
+  EXPECT_LT(worst_error(aligned), worst_error(told) + 0.05e-3) << worst_error(aligned) * 1e3 << " vs " << worst_error(told) * 1e3;
   std::printf("ring-free phantom: aligned %.3f mm, misaligned %.3f mm, told the pose %.3f mm\n", worst_error(aligned) * 1e3,
               worst_error(moved) * 1e3, worst_error(told) * 1e3);
 }

@@ -25,9 +25,17 @@ class SurfaceProjector {
   virtual Projection project(const Vec3& p) const = 0;
 };
 
-/// Projector onto a triangle mesh (face normals); flags closest points on its border
-/// edges (edges of a single triangle).
-std::unique_ptr<SurfaceProjector> make_mesh_projector(const SurfaceMesh& mesh);
+/// The normal a mesh projector gives with its closest point.
+enum class MeshNormals {
+  Face,          ///< the closest triangle's normal: jumps where the closest point crosses an edge
+  Interpolated,  ///< the area-weighted vertex normals blended by the closest point's barycentric
+                 ///< weights: continuous across edges, so the point-to-plane constraint moves
+                 ///< continuously with the skin
+};
+
+/// Projector onto a triangle mesh; flags closest points on its border edges (edges of a
+/// single triangle).
+std::unique_ptr<SurfaceProjector> make_mesh_projector(const SurfaceMesh& mesh, MeshNormals normals = MeshNormals::Face);
 /// Projector onto a point cloud: nearest point, normal from the PCA of its `neighbours`
 /// nearest points. Throws InputError for fewer than neighbours + 1 points or NaN points.
 std::unique_ptr<SurfaceProjector> make_cloud_projector(const Points& cloud, int neighbours = 12);

@@ -36,6 +36,9 @@ struct StepReport {
   /// contracting), and the projections that took an Anderson-accelerated iterate
   double contraction = 0, fixed_point_distance = 0;
   int accelerated_projections = 0;
+  /// surface step: the held skin's RMS motion [m] at each projection, in order (how the
+  /// alternation converged, stalled or jittered)
+  std::vector<double> projection_residuals;
   /// surface step: skin vertices constrained by the last projection (the others were too
   /// far from the supine surface or projected onto its border) and all skin vertices
   int constrained_skin = 0, skin_vertices = 0;

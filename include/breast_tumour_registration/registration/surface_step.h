@@ -51,6 +51,13 @@ struct SurfaceStepOptions {
   /// Projections onto the border of an open supine surface (the edge of a depth scan, the
   /// rim of a hole behind an occlusion) are dropped: that skin is not in the scan.
   bool reject_boundary = true;
+  /// The normal of the point-to-plane springs on a supine mesh (the pipeline builds its
+  /// projector with it). Interpolated by default: with the closest face's normal the springs
+  /// jump where a closest point crosses an edge, and on soft tissue the alternation ended in a
+  /// jitter of about 0.1 mm per projection instead of contracting (issue 10, BENCHMARKS.md:
+  /// not converged 38 -> 17 of 116 suite runs on the phantom, 61 -> 48 of 112 on the TetGen
+  /// body; on SfePy's truth every scene as close or closer).
+  MeshNormals target_normals = MeshNormals::Interpolated;
   NewtonOptions newton;
 };
 
