@@ -9,6 +9,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/anderson_acceleration.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
+#include "breast_tumour_registration/fem/fixed_point_estimate.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/plane_constraint_energy.h"
 #include "breast_tumour_registration/fem/point_constraint_energy.h"
@@ -163,15 +164,10 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // contracts far more than the slow tangential relaxation after it).
     const auto [residual, largest_change] = held_change(g, x);
     residuals.push_back(residual);
-    // The contraction: the larger of the last two residual ratios (cautious; NaN until both
-    // exist). For the plain iteration it is the map's contraction; with Anderson's iterates the
-    // rate at which the residual falls.
-    double q_hat = std::numeric_limits<double>::quiet_NaN();
-    if (residuals.size() >= 3) {
-      const size_t k = residuals.size() - 1;
-      q_hat = std::max(residuals[k] / residuals[k - 1], residuals[k - 1] / residuals[k - 2]);
-    }
-    const double distance = q_hat < 1 ? residual / (1 - q_hat) : std::numeric_limits<double>::infinity();
+    // The contraction and the distance to the fixed point (fixed_point_estimate.h: one-step
+    // ratios, or two-step ones where the residuals alternate large and small).
+    const FixedPointEstimate fp = estimate_fixed_point(residuals);
+    const double q_hat = fp.contraction, distance = fp.distance;
     rep.projection_rms_change = residual;
     rep.projection_max_change = largest_change;
     rep.contraction = q_hat;

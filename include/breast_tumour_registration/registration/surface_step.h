@@ -25,7 +25,8 @@ struct SurfaceStepOptions {
   int newton_per_projection = 1; ///< Newton iterations between projections (thesis: 1)
   /// [m] Convergence: the held skin's estimated RMS distance from the fixed point of the
   /// projection/Newton alternation, |G(x) - x| / (1 - q) with q the rate at which that
-  /// residual falls (the larger of its last two ratios), is below this, or the alternation
+  /// residual falls (fixed_point_estimate.h: the larger of its last two ratios, or two-step
+  /// ratios where the residuals alternate large and small), is below this, or the alternation
   /// reached its floor (floor_projections); then Newton on the settled projections meets
   /// its gradient criterion (up to newton.max_iterations). Not the last step alone: on soft
   /// tissue q is 0.8 to 0.9, and a step of 0.1 mm left the skin about 0.5 mm from where it
