@@ -28,7 +28,7 @@ static double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Register noisy rendered depth scans of a scene's supine side with the exact pose; the spread over scans."};
-  std::string scene_path, preset = "balanced";
+  std::string scene_path, preset = "balanced", normals = "interpolated";
   int scans = 9, anderson = -1;
   double noise_mm = 1.0, smoothing = LiveSceneOptions{}.smoothing_pixels;
   unsigned seed = 1;
@@ -40,12 +40,15 @@ int main(int argc, char** argv) {
   app.add_option("--smoothing-px", smoothing, "the scan's Gaussian smoothing before registration [px] (0: none)")
       ->check(CLI::Range(0.0, 50.0))->capture_default_str();
   app.add_option("--seed", seed, "first scan's noise seed")->capture_default_str();
+  app.add_option("--target-normals", normals, "the point-to-plane springs' normal on the scan's mesh")
+      ->check(CLI::IsMember({"face", "interpolated"}))->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     const Scene scene = load_scene(scene_path);
     if (!scene.supine_surface) throw InputError(scene_path + ": field 'supine.surface' is needed to render a depth scan");
     RegistrationOptions opt = preset_options(preset);
     if (anderson >= 0) opt.surface.anderson_depth = anderson;
+    opt.surface.target_normals = normals == "face" ? MeshNormals::Face : MeshNormals::Interpolated;
     RegistrationEngine engine(scene);
     std::vector<const SurfaceMesh*> seen = {&*scene.supine_surface};
     if (scene.supine_rigid) seen.push_back(&*scene.supine_rigid);
@@ -55,7 +58,7 @@ int main(int argc, char** argv) {
     const RegistrationResult file = engine.solve(opt);
     double file_worst = 0;
     for (const auto& t : file.tumours) file_worst = std::max(file_worst, t.centroid_distance);
-    std::printf("smoothing %.1f px; ", smoothing);
+    std::printf("smoothing %.1f px, %s normals; ", smoothing, normals.c_str());
     std::printf("scene %s, preset %s, depth noise %.2f mm, %d scans; the scene's own supine surface: worst tumour %.3f mm\n",
                 scene_path.c_str(), preset.c_str(), noise_mm, scans, file_worst * 1e3);
     std::vector<double> worst, seconds, projections;
