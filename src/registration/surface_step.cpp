@@ -130,7 +130,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   int fallback_at = 0;
   long fallback_inverted = 0;
   bool aborted = false;
-  std::vector<double> residuals;  // per projection [m]
+  std::vector<double>& residuals = rep.projection_residuals;  // per projection [m]
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
     if (callback) nopt.callback = [&](const IterationInfo& it) {
       IterationInfo shifted = it;
@@ -168,7 +168,6 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // ratios, or two-step ones where the residuals alternate large and small).
     const FixedPointEstimate fp = estimate_fixed_point(residuals);
     const double q_hat = fp.contraction, distance = fp.distance;
-    rep.projection_rms_change = residual;
     rep.projection_max_change = largest_change;
     rep.contraction = q_hat;
     rep.fixed_point_distance = distance;
@@ -268,7 +267,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   }
   if (!finished)
     rep.stop_reason = "projection cap (" + std::to_string(opt.max_projections) + ") reached, the skin still moving " +
-                      std::to_string(rep.projection_rms_change * 1e3) + " mm RMS per projection (estimated " +
+                      std::to_string(rep.projection_rms_change() * 1e3) + " mm RMS per projection (estimated " +
                       (std::isfinite(rep.fixed_point_distance) ? std::to_string(rep.fixed_point_distance * 1e3) + " mm" : std::string("an unknown distance")) +
                       " from the fixed point; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm)";
   // A limit that inverts elements the state at the step's start did not have is no answer
@@ -299,7 +298,6 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     rep.note = "the surface step did not reach its fixed point; the result is the state where the skin first moved less than " +
                std::to_string(opt.projection_tolerance * 1e3) + " mm per projection";
   }
-  rep.projection_residuals = residuals;
   if (pose) *pose = free_springs->size() >= 3 ? free_springs->pose(x) : P;
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;

@@ -91,7 +91,7 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
       << ", \"stop\": " << quote(s.stop_reason) << ", \"newton_iterations\": " << s.iterations
       << ", \"projections\": " << s.outer_iterations << ", \"seconds\": " << num(s.seconds)
       << ", \"energy_J\": " << num(s.energy) << ", \"gradient_norm_N\": " << num(s.gradient_norm)
-      << ", \"projection_rms_change_mm\": " << num(s.projection_rms_change * 1e3)
+      << ", \"projection_rms_change_mm\": " << num(s.projection_rms_change() * 1e3)
       << ", \"fixed_point_distance_mm\": " << num(s.fixed_point_distance * 1e3) << ", \"contraction\": " << num(s.contraction)
       << ", \"accelerated_projections\": " << s.accelerated_projections << ", \"projection_rms_changes_mm\": [";
     for (size_t k = 0; k < s.projection_residuals.size(); ++k) j << (k ? ", " : "") << num(s.projection_residuals[k] * 1e3);

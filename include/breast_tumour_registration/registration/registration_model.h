@@ -29,8 +29,7 @@ struct StepReport {
   double seconds = 0;
   double energy = 0;
   double gradient_norm = 0;
-  double projection_rms_change = 0;  ///< surface step: RMS motion of the held skin between the last two projections [m]
-  double projection_max_change = 0;  ///< surface step: the largest such motion [m]
+  double projection_max_change = 0;  ///< surface step: the largest motion of a held skin vertex between the last two projections [m]
   /// surface step: the contraction of the alternation measured over the last iterates, the
   /// skin's estimated RMS distance from its fixed point at the end [m] (infinite: not
   /// contracting), and the projections that took an Anderson-accelerated iterate
@@ -39,6 +38,8 @@ struct StepReport {
   /// surface step: the held skin's RMS motion [m] at each projection, in order (how the
   /// alternation converged, stalled or jittered)
   std::vector<double> projection_residuals;
+  /// surface step: RMS motion of the held skin between the last two projections [m] (0: none yet)
+  double projection_rms_change() const { return projection_residuals.empty() ? 0.0 : projection_residuals.back(); }
   /// surface step: skin vertices constrained by the last projection (the others were too
   /// far from the supine surface or projected onto its border) and all skin vertices
   int constrained_skin = 0, skin_vertices = 0;
