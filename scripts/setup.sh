@@ -15,6 +15,7 @@ DEB_PACKAGES=(
   rosbash python3-rosservice  # rosrun, rosservice: the README's commands
   libsensor-msgs-dev libshape-msgs-dev libvisualization-msgs-dev libgeometry-msgs-dev libdiagnostic-msgs-dev
   libtf2-msgs-dev
+  libnifti2-dev libteem-dev nlohmann-json3-dev  # label maps (NIfTI, NRRD) and Slicer markups (issue 15)
   libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
   python3-matplotlib python3-numpy zlib1g-dev cmake g++ make time
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for scripts/run_fuzz.sh (part of the tests)
