@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 
@@ -15,6 +16,7 @@
 #include "breast_tumour_registration/geometry/tetrahedralize.h"
 #include "breast_tumour_registration/geometry/validation.h"
 #include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/markups_io.h"
 #include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/io/yaml_fields.h"
 
@@ -40,7 +42,7 @@ namespace {
 // landmark_vertices, generator, supine.tet_mesh_ground_truth) are written by btr_phantom.
 const std::vector<std::string> kSceneKeys = {
     "units", "frame", "prone", "prone.tet_mesh", "prone.surface", "prone.cell_size_mm", "rest", "rest.tet_mesh",
-    "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmark_set", "landmark_vertices.*", "supine",
+    "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmarks.prone", "landmarks.supine", "patient_frame", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
     "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "regions", "regions[]",
@@ -82,7 +84,22 @@ void mesh_prone(Scene& s, double cell_size) {
   } catch (const InputError& e) {
     throw InputError(s.path + ": field 'chest_wall': " + e.what());
   }
-  if (src.landmarks.rows()) s.landmark_anchors = attach_to_boundary(s.prone, src.landmarks).anchors;
+  if (src.landmarks.rows()) {
+    const BoundaryAttachment a = attach_to_boundary(s.prone, src.landmarks);
+    check_landmark_attachment(a, s.landmark_labels, s.path);
+    s.landmark_anchors = a.anchors;
+  }
+}
+
+void check_landmark_attachment(const BoundaryAttachment& a, const std::vector<std::string>& labels, const std::string& path) {
+  for (size_t i = 0; i < a.distances.size(); ++i)
+    if (a.distances[i] > kMaxLandmarkSkinDistance) {
+      const std::string name = i < labels.size() ? "'" + labels[i] + "'" : std::to_string(i);
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " is %.1f mm from the prone skin (at most %.0f mm)", a.distances[i] * 1e3, kMaxLandmarkSkinDistance * 1e3);
+      throw InputError(path + ": field 'landmarks': prone landmark " + name + buf +
+                       ": is the point list's coordinate system (LPS/RAS) or the scene's patient_frame wrong?");
+    }
 }
 
 void check_length_scale(const Points& V, LengthUnit units, const std::string& file, const std::string& field) {
@@ -184,8 +201,34 @@ Scene load_scene_fields(const std::string& path) {
   if (supine && supine["chest_ring"]) s.supine_rigid = open_surface(supine["chest_ring"], "supine.chest_ring");
   if (root["chest_ring"]) s.prone_rigid = open_surface(root["chest_ring"], "chest_ring");
 
-  // Landmarks.
-  if (root["landmarks"]) {
+  // Landmarks: Slicer point lists matched by label, or a file of vertex index pairs.
+  if (root["landmarks"] && root["landmarks"].IsMap()) {
+    const YAML::Node lm = root["landmarks"];
+    if (!lm["prone"] || !lm["supine"]) c.fail("landmarks", "give both landmarks.prone and landmarks.supine (Slicer .mrk.json or .fcsv)");
+    if (!root["patient_frame"])
+      c.fail("patient_frame", "missing: with Slicer point lists the scene must say in which patient frame its own coordinates are "
+                              "(patient_frame: RAS or LPS; btr_scene_from_labels writes RAS)");
+    const PatientFrame frame = c.load("patient_frame", [&] { return parse_patient_frame(c.text(root["patient_frame"], "patient_frame"), "patient_frame"); });
+    s.patient_frame = frame;
+    const auto prone_pts = c.load("landmarks.prone", [&] { return read_markups(c.path_of(lm["prone"], "landmarks.prone"), frame); });
+    const auto supine_pts = c.load("landmarks.supine", [&] { return read_markups(c.path_of(lm["supine"], "landmarks.supine"), frame); });
+    const MatchedPoints m = match_by_label(prone_pts, supine_pts);
+    if (m.labels.empty()) c.fail("landmarks", "no label is in both point lists, so no landmark pair can be made");
+    if (!m.unmatched.empty()) {
+      std::string list;
+      for (const auto& l : m.unmatched) list += (list.empty() ? "" : ", ") + l;
+      s.warnings.push_back("landmarks: " + std::to_string(m.unmatched.size()) + " points in only one list, not used: " + list);
+    }
+    s.landmark_labels = m.labels;
+    s.landmark_supine = m.second;
+    if (s.prone_source) {
+      s.prone_source->landmarks = m.first;
+    } else {
+      const BoundaryAttachment a = attach_to_boundary(s.prone, m.first);
+      check_landmark_attachment(a, m.labels, path);
+      s.landmark_anchors = a.anchors;
+    }
+  } else if (root["landmarks"]) {
     const auto pairs = c.load("landmarks", [&] { return read_landmark_pairs(c.path_of(root["landmarks"], "landmarks"), s.units); });
     Points prone_pts(pairs.size(), 3);
     s.landmark_supine.resize(pairs.size(), 3);

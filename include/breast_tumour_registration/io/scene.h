@@ -8,6 +8,8 @@
 //   chest_wall: chest_wall.txt     # vertex indices of prone.tet_mesh (or of prone.surface)
 //   chest_ring: chest_ring.obj     # optional: prone rigid skin around the breast (for ICP)
 //   landmarks: landmarks.csv       # optional: prone index with supine index or supine x,y,z
+//   # landmarks: {prone: prone.mrk.json, supine: supine.mrk.json}   # or Slicer point lists,
+//   patient_frame: RAS             # matched by label; then the scene says its frame (RAS or LPS)
 //   supine:
 //     surface: supine.obj          # optional: supine surface (closed mesh or open scan)
 //     cloud: scan.xyz              # optional instead of surface: unorganized points (.xyz, .ply, .obj)
@@ -39,6 +41,8 @@
 #include "breast_tumour_registration/fem/material_parameters.h"
 #include "breast_tumour_registration/fem/material_region.h"
 #include "breast_tumour_registration/geometry/anchor.h"
+#include "breast_tumour_registration/geometry/label_volume.h"
+#include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 
 namespace btr {
@@ -70,6 +74,8 @@ struct Scene {
   double tetrahedralize_seconds = 0;
   std::vector<int> chest_wall;           ///< prone tet vertex indices
   std::vector<Anchor> landmark_anchors;  ///< prone landmark points
+  std::vector<std::string> landmark_labels;  ///< one per anchor when the landmarks came from point lists
+  std::optional<PatientFrame> patient_frame;  ///< `patient_frame`: the scene's coordinates in RAS or LPS
   Points landmark_supine;                ///< supine landmark positions (supine frame), one row per anchor
   std::optional<SurfaceMesh> supine_surface;  ///< supine frame
   std::optional<Points> supine_cloud;         ///< supine frame; used when there is no supine_surface
@@ -115,6 +121,12 @@ Scene load_scene(const std::string& path, const SceneLoadOptions& opt = {});
 /// Tetrahedralizes s.prone_source at cell_size [m] and re-attaches the chest wall and the
 /// landmarks to the tetrahedra. InputError naming the field on failure.
 void mesh_prone(Scene& s, double cell_size);
+
+/// A prone landmark further than this from the prone skin is a frame or units mistake [m].
+constexpr double kMaxLandmarkSkinDistance = 0.010;
+/// InputError naming the landmark (by its label when given) that lies further than
+/// kMaxLandmarkSkinDistance from the skin it was attached to.
+void check_landmark_attachment(const BoundaryAttachment& a, const std::vector<std::string>& labels, const std::string& path);
 
 /// Throws InputError (naming file and field) when a mesh's extent is not that of a breast
 /// (1 cm to 3 m): most often a metre file read as millimetres, or the other way round.
