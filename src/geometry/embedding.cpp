@@ -127,9 +127,7 @@ Embedding embed_points(const TetMesh& mesh, const Points& P, OutsidePolicy polic
   return e;
 }
 
-namespace {
-// Winding number of a closed surface around p (robust to how the surface is sampled).
-bool inside_closed(const SurfaceMesh& s, const Vec3& p) {
+bool inside_closed_surface(const SurfaceMesh& s, const Vec3& p) {
   double w = 0;
   for (Eigen::Index f = 0; f < s.F.rows(); ++f) {
     const Vec3 a = Vec3(s.V.row(s.F(f, 0))) - p, b = Vec3(s.V.row(s.F(f, 1))) - p, c = Vec3(s.V.row(s.F(f, 2))) - p;
@@ -138,7 +136,6 @@ bool inside_closed(const SurfaceMesh& s, const Vec3& p) {
   }
   return w / (4 * M_PI) > 0.5;
 }
-}  // namespace
 
 std::vector<int> tetrahedra_inside(const TetMesh& mesh, const std::vector<const SurfaceMesh*>& surfaces) {
   std::vector<int> out;
@@ -148,7 +145,7 @@ std::vector<int> tetrahedra_inside(const TetMesh& mesh, const std::vector<const 
     for (const SurfaceMesh* s : surfaces) {
       const Vec3 lo = s->V.colwise().minCoeff().transpose(), hi = s->V.colwise().maxCoeff().transpose();
       if ((c.array() < lo.array()).any() || (c.array() > hi.array()).any()) continue;
-      if (inside_closed(*s, c)) {
+      if (inside_closed_surface(*s, c)) {
         out.push_back(static_cast<int>(e));
         break;
       }

@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/simulation/label_phantom.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 
 namespace fs = std::filesystem;
@@ -51,6 +52,12 @@ int main(int argc, char** argv) {
   app.add_option("--volume-form", volume_form, "volume term of the generating material: auto, element or nodal "
                                                "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
       ->capture_default_str();
+  std::string label_dir;
+  double voxel_mm = 1.0;
+  app.add_option("--label-map", label_dir, "also write the prone phantom as a segmented image into this folder (RAS NIfTI label "
+                                           "map: fat 1, gland 2, tumour 3, muscle 4; fiducials as Slicer .mrk.json in LPS; "
+                                           "supine surface and tumour truth in RAS), for btr_scene_from_labels");
+  app.add_option("--voxel-size", voxel_mm, "voxel size of --label-map [mm]")->capture_default_str()->check(btr::cli::positive());
   app.add_flag("-q,--quiet", quiet, "no per-iteration progress");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
@@ -86,6 +93,13 @@ int main(int argc, char** argv) {
                   r->t_assembly, r->t_factorization, r->t_solve, r->t_line_search);
     std::printf("[phantom] tumour centroids, prone -> supine displacement:");
     for (const auto& [name, d] : s.tumour_displacement) std::printf(" %s %.1f mm", name.c_str(), d * 1e3);
+    if (!label_dir.empty()) {
+      LabelPhantomOptions lo;
+      lo.voxel_size = voxel_mm * 1e-3;
+      const LabelPhantomFiles f = write_label_phantom((fs::path(out_dir) / "scene.yaml").string(), label_dir, lo);
+      std::printf("[phantom] label map %s: %d x %d x %d voxels of %.2f mm\n", f.label_map.c_str(), f.volume.nx, f.volume.ny,
+                  f.volume.nz, voxel_mm);
+    }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("\n[phantom] wrote scene to %s (scene.yaml, rest/prone/supine .vtk and surfaces, 15 tumour OBJs, "
                 "landmarks.csv, chest_wall.txt, chest_ring.obj) in %.1f s\n",

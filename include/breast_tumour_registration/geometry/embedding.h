@@ -29,6 +29,10 @@ struct Embedding {
 Embedding embed_points(const TetMesh& mesh, const Points& P, OutsidePolicy policy = OutsidePolicy::NearestTetrahedron,
                        double tolerance = 1e-9);
 
+/// Whether p is inside the closed surface s (winding number above 1/2; robust to how the
+/// surface is sampled). O(#faces) per query.
+bool inside_closed_surface(const SurfaceMesh& s, const Vec3& p);
+
 /// Tetrahedra of `mesh` whose centroid lies inside any of the closed `surfaces` (winding
 /// number), e.g. the elements of a tumour that get their own material.
 std::vector<int> tetrahedra_inside(const TetMesh& mesh, const std::vector<const SurfaceMesh*>& surfaces);
