@@ -606,9 +606,10 @@ TetMeshFile read_vtk(const std::string& path, double scale) {
   return f;
 }
 
-void write_vtk(const std::string& path, const TetMesh& m, double inv, const std::vector<int>& labels) {
+void write_vtk(const std::string& path, const TetMesh& m, double inv, const std::vector<int>& labels, const std::string& title) {
   auto out = open_out(path);
-  out << "# vtk DataFile Version 3.0\nbreast_tumour_registration tetrahedral mesh\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  out << "# vtk DataFile Version 3.0\n" << (title.empty() ? "breast_tumour_registration tetrahedral mesh" : title)
+      << "\nASCII\nDATASET UNSTRUCTURED_GRID\n";
   out << "POINTS " << m.V.rows() << " double\n";
   for (Eigen::Index i = 0; i < m.V.rows(); ++i)
     out << m.V(i, 0) * inv << ' ' << m.V(i, 1) * inv << ' ' << m.V(i, 2) * inv << '\n';
@@ -778,12 +779,14 @@ std::vector<int> cell_labels(const TetMeshFile& file, const std::string& array, 
   return labels;
 }
 
-void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit, const std::vector<int>& labels) {
+void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit, const std::vector<int>& labels,
+                    const std::string& title) {
   if (!labels.empty() && static_cast<Eigen::Index>(labels.size()) != mesh.T.rows())
     throw InputError("'" + path + "': " + std::to_string(labels.size()) + " cell labels for " + std::to_string(mesh.T.rows()) + " tetrahedra");
   const std::string ext = file_extension(path);
   const double inv = 1.0 / metres_per_unit(unit);
-  if (ext == ".vtk") return write_vtk(path, mesh, inv, labels);
+  if (title.find('\n') != std::string::npos) throw InputError(path + ": a VTK title is one line");
+  if (ext == ".vtk") return write_vtk(path, mesh, inv, labels, title);
   if (ext == ".mesh") return write_medit(path, mesh, inv, labels);
   throw InputError("'" + path + "': unknown tetrahedral mesh format '" + ext + "' (expected .vtk or .mesh)");
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -10,7 +11,9 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/io/cross_section_image.h"
+#include "breast_tumour_registration/io/markups_io.h"
 #include "breast_tumour_registration/io/mesh_io.h"
+#include "breast_tumour_registration/io/markups_io.h"
 
 namespace btr {
 namespace {
@@ -196,6 +199,33 @@ std::vector<std::string> write_registration_outputs(const std::string& dir, cons
     write_surface(path("tumour_" + t.name + "_registered.ply"), t.registered, scene.units);
   }
   std::ofstream(path("report.json")) << registration_report_json(scene, model, r, prepare_seconds);
+  // For 3D Slicer, when the scene says its patient frame: LPS millimetres (Slicer's file
+  // convention), the tissue labels on the mesh, the tumour centroids as a point list.
+  if (scene.patient_frame) {
+    fs::create_directories(fs::path(dir) / "slicer");
+    auto lps = [&](const Points& P) {
+      Points Q = P;
+      for (Eigen::Index i = 0; i < Q.rows(); ++i)
+        Q.row(i) = convert_patient_frame(P.row(i).transpose(), *scene.patient_frame, PatientFrame::LPS).transpose();
+      return Q;
+    };
+    const bool labelled = static_cast<Eigen::Index>(scene.prone_labels.size()) == deformed.T.rows();
+    write_tet_mesh(path("slicer/registered.vtk"), TetMesh{lps(deformed.V), deformed.T}, LengthUnit::Millimetre,
+                   labelled ? scene.prone_labels : std::vector<int>{}, "breast_tumour_registration registered breast SPACE=LPS");
+    std::vector<NamedPoint> centroids;
+    std::vector<std::string> notes;
+    for (const auto& t : r.tumours) {
+      write_surface(path("slicer/tumour_" + t.name + ".ply"), SurfaceMesh{lps(t.registered.V), t.registered.F}, LengthUnit::Millimetre);
+      centroids.push_back({t.name, t.centroid});
+      char buf[160] = "";
+      if (t.uncertainty)
+        std::snprintf(buf, sizeof buf, "95 %% radius %.2f mm (experimental, not validated)", t.uncertainty->radius_95 * 1e3);
+      notes.push_back(buf);
+    }
+    if (!centroids.empty()) {
+      write_markups(path("slicer/tumour_centroids.mrk.json"), centroids, *scene.patient_frame, PatientFrame::LPS, notes);
+    }
+  }
 
   // Cross-section through the first tumour (or the model centre).
   const SurfaceMesh prone_skin = transform_surface(to_supine, boundary_surface(TetMesh{model.prone, model.rest.T}));

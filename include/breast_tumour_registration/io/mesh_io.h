@@ -41,8 +41,10 @@ TetMesh read_tet_mesh(const std::string& path, LengthUnit unit);
 /// file's only cell array. InputError naming `path` when it is missing, ambiguous or not integer.
 std::vector<int> cell_labels(const TetMeshFile& file, const std::string& array, const std::string& path);
 /// Writes legacy VTK (.vtk) or Medit (.mesh); `labels` (one per tetrahedron, or empty) go to
-/// CELL_DATA "label" or the Medit element references.
-void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit, const std::vector<int>& labels = {});
+/// CELL_DATA "label" or the Medit element references. `title`: VTK's second line (3D Slicer
+/// reads the frame from it, e.g. "... SPACE=LPS"); empty: the package's own.
+void write_tet_mesh(const std::string& path, const TetMesh& mesh, LengthUnit unit, const std::vector<int>& labels = {},
+                    const std::string& title = {});
 
 /// Lower-case extension including the dot (".obj"); empty when there is none.
 std::string file_extension(const std::string& path);
