@@ -1,5 +1,6 @@
 #include "breast_tumour_registration/simulation/label_phantom.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -27,7 +28,7 @@ SurfaceMesh to_ras(const SurfaceMesh& s) { return SurfaceMesh{to_ras(s.V), s.F};
 
 LabelPhantomFiles write_label_phantom(const std::string& scene_yaml, const std::string& dir, const LabelPhantomOptions& opt) {
   namespace fs = std::filesystem;
-  if (!(opt.voxel_size > 0) || !(opt.muscle_thickness > 0) || !(opt.margin >= 0))
+  if (!(opt.muscle_thickness > 0) || !(opt.margin >= 0))
     throw InputError("label phantom: voxel size and muscle thickness must be positive, the margin >= 0");
   SceneLoadOptions lo;
   const Scene s = load_scene(scene_yaml, lo);
@@ -38,27 +39,36 @@ LabelPhantomFiles write_label_phantom(const std::string& scene_yaml, const std::
   // half a voxel either side of it, so that the labels' interface falls on it.
   for (int v : s.chest_wall)
     if (std::abs(prone.V(v, 1)) > 1e-6) throw InputError(scene_yaml + ": the chest wall is not the plane z = 0 of a phantom");
-  const double h = opt.voxel_size;
+  const Vec3 h = opt.voxel_size;
+  if (!(h.minCoeff() > 0) || (opt.min_voxels.array() < 0).any()) throw InputError("label phantom: voxel sizes must be positive");
   const Vec3 lo_ras = prone.V.colwise().minCoeff().transpose() - Vec3::Constant(opt.margin);
   const Vec3 hi_ras = prone.V.colwise().maxCoeff().transpose() + Vec3::Constant(opt.margin);
-  const int n_muscle = static_cast<int>(std::ceil(opt.muscle_thickness / h));
+  const int n_muscle = static_cast<int>(std::ceil(opt.muscle_thickness / h.y()));
+  // The breast's own box of voxels, then air around it up to opt.min_voxels.
+  const int bx = static_cast<int>(std::ceil((hi_ras.x() - lo_ras.x()) / h.x())) + 1;
+  const int bz = static_cast<int>(std::ceil((hi_ras.z() - lo_ras.z()) / h.z())) + 1;
+  const int by_front = static_cast<int>(std::ceil(hi_ras.y() / h.y())) + 1;
+  const int pad_x = std::max(0, opt.min_voxels.x() - bx) / 2, pad_z = std::max(0, opt.min_voxels.z() - bz) / 2;
+  const int n_back = std::max(2, (opt.min_voxels.y() - n_muscle - by_front) / 2);
   LabelVolume v;
-  v.nx = static_cast<int>(std::ceil((hi_ras.x() - lo_ras.x()) / h)) + 1;
-  v.nz = static_cast<int>(std::ceil((hi_ras.z() - lo_ras.z()) / h)) + 1;
-  const int n_air_back = 2;
-  v.ny = n_air_back + n_muscle + static_cast<int>(std::ceil(hi_ras.y() / h)) + 1;
-  v.ijk_to_ras = Mat3::Identity() * h;
-  v.origin = Vec3(lo_ras.x(), -(n_air_back + n_muscle - 0.5) * h, lo_ras.z());
+  v.nx = std::max(bx, opt.min_voxels.x());
+  v.nz = std::max(bz, opt.min_voxels.z());
+  v.ny = std::max(n_back + n_muscle + by_front, opt.min_voxels.y());
+  const double voxels = static_cast<double>(v.nx) * v.ny * v.nz;
+  if (voxels > static_cast<double>(kMaxLabelVoxels)) throw InputError("label phantom: more voxels than a label map may have");
+  v.ijk_to_ras = h.asDiagonal();
+  v.origin = Vec3(lo_ras.x() - pad_x * h.x(), -(n_back + n_muscle - 0.5) * h.y(), lo_ras.z() - pad_z * h.z());
   v.labels.assign(static_cast<size_t>(v.voxel_count()), 0);
   v.names = {{opt.fat, "fat"}, {opt.gland, "gland"}, {opt.tumour, "tumour"}, {opt.muscle, "muscle"}};
-  const int first_tissue = n_air_back + n_muscle;  // the first voxel layer anterior of the chest wall
+  const int first_tissue = n_back + n_muscle;  // the first voxel layer anterior of the chest wall
+  const int j_end = std::min(v.ny, first_tissue + by_front);
 
   // Tissue: voxel centres inside the prone mesh take the label of their tetrahedron.
   std::vector<long> ids;
   std::vector<Vec3> centres;
-  for (int k = 0; k < v.nz; ++k)
-    for (int j = first_tissue; j < v.ny; ++j)
-      for (int i = 0; i < v.nx; ++i) {
+  for (int k = pad_z; k < std::min(v.nz, pad_z + bz); ++k)
+    for (int j = first_tissue; j < j_end; ++j)
+      for (int i = pad_x; i < std::min(v.nx, pad_x + bx); ++i) {
         ids.push_back(v.index(i, j, k));
         centres.push_back(v.centre(i, j, k));
       }
@@ -86,7 +96,7 @@ LabelPhantomFiles write_label_phantom(const std::string& scene_yaml, const std::
   for (int k = 0; k < v.nz; ++k)
     for (int i = 0; i < v.nx; ++i)
       if (v.at(i, first_tissue, k) != 0)
-        for (int j = n_air_back; j < first_tissue; ++j) v.labels[static_cast<size_t>(v.index(i, j, k))] = static_cast<std::uint8_t>(opt.muscle);
+        for (int j = n_back; j < first_tissue; ++j) v.labels[static_cast<size_t>(v.index(i, j, k))] = static_cast<std::uint8_t>(opt.muscle);
 
   fs::create_directories(dir);
   auto path = [&](const std::string& f) { return (fs::path(dir) / f).string(); };

@@ -53,11 +53,20 @@ int main(int argc, char** argv) {
                                                "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
       ->capture_default_str();
   std::string label_dir;
-  double voxel_mm = 1.0;
+  std::vector<double> voxel_mm = {1.0};
+  std::vector<int> min_voxels;
   app.add_option("--label-map", label_dir, "also write the prone phantom as a segmented image into this folder (RAS NIfTI label "
                                            "map: fat 1, gland 2, tumour 3, muscle 4; fiducials as Slicer .mrk.json in LPS; "
                                            "supine surface and tumour truth in RAS), for btr_scene_from_labels");
-  app.add_option("--voxel-size", voxel_mm, "voxel size of --label-map [mm]")->capture_default_str()->check(btr::cli::positive());
+  app.add_option("--voxel-size", voxel_mm, "voxel size of --label-map [mm]: one value, or three (RAS x, y, z)")
+      ->capture_default_str()
+      ->expected(1, 3)
+      ->delimiter(',')
+      ->check(btr::cli::positive());
+  app.add_option("--label-map-voxels", min_voxels, "grow the label map with air to at least NX,NY,NZ voxels (an MRI field of view)")
+      ->expected(3)
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", quiet, "no per-iteration progress");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
 
@@ -95,10 +104,12 @@ int main(int argc, char** argv) {
     for (const auto& [name, d] : s.tumour_displacement) std::printf(" %s %.1f mm", name.c_str(), d * 1e3);
     if (!label_dir.empty()) {
       LabelPhantomOptions lo;
-      lo.voxel_size = voxel_mm * 1e-3;
+      if (voxel_mm.size() == 2) throw InputError("--voxel-size: give one value or three");
+      lo.voxel_size = voxel_mm.size() == 3 ? Vec3(Vec3(voxel_mm[0], voxel_mm[1], voxel_mm[2]) * 1e-3) : Vec3(Vec3::Constant(voxel_mm[0] * 1e-3));
+      if (min_voxels.size() == 3) lo.min_voxels = Eigen::Vector3i(min_voxels[0], min_voxels[1], min_voxels[2]);
       const LabelPhantomFiles f = write_label_phantom((fs::path(out_dir) / "scene.yaml").string(), label_dir, lo);
-      std::printf("[phantom] label map %s: %d x %d x %d voxels of %.2f mm\n", f.label_map.c_str(), f.volume.nx, f.volume.ny,
-                  f.volume.nz, voxel_mm);
+      std::printf("[phantom] label map %s: %d x %d x %d voxels of %.2f x %.2f x %.2f mm\n", f.label_map.c_str(), f.volume.nx,
+                  f.volume.ny, f.volume.nz, lo.voxel_size.x() * 1e3, lo.voxel_size.y() * 1e3, lo.voxel_size.z() * 1e3);
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::printf("\n[phantom] wrote scene to %s (scene.yaml, rest/prone/supine .vtk and surfaces, 15 tumour OBJs, "

@@ -19,7 +19,10 @@ namespace btr {
 Mat3 phantom_to_ras();
 
 struct LabelPhantomOptions {
-  double voxel_size = 0.001;        ///< isotropic [m]
+  Vec3 voxel_size = Vec3::Constant(0.001);  ///< along RAS x, y, z [m]
+  /// The grid grows (air around the breast, centred) to at least this many voxels, e.g. an MRI
+  /// field of view of 512 x 512 x 160; 0: just the breast, the muscle and a margin.
+  Eigen::Vector3i min_voxels = Eigen::Vector3i::Zero();
   double muscle_thickness = 0.006;  ///< pectoral slab behind the chest wall [m]
   double margin = 0.004;            ///< air around the breast [m]
   int fat = 1, gland = 2, tumour = 3, muscle = 4;  ///< label values (LabelTable's defaults)
