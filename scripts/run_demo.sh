@@ -7,7 +7,18 @@
 #   4. roslaunch demo.launch starts a master, the registration node, bag replay and a client that
 #      calls the service and prints the tumour centroid error and timings; everything stops after.
 # Outputs go to out/demo (override with BTR_OUT).
+# --from-labels: step 2 starts from the phantom as a segmented image instead (a RAS NIfTI label
+# map with LPS Slicer fiducials, as 3D Slicer exports them): btr_scene_from_labels meshes it
+# and btr_register registers that scene, with Slicer-ready results in registration/slicer/.
 set -euo pipefail
+FROM_LABELS=0
+for a in "$@"; do
+  case "$a" in
+    --from-labels) FROM_LABELS=1 ;;
+    *) echo "run_demo.sh: unknown option '$a' (known: --from-labels)" >&2; exit 2 ;;
+  esac
+done
+set --
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$REPO_ROOT/scripts/setup.sh"
 OUT="${BTR_OUT:-$REPO_ROOT/out/demo}"
@@ -15,12 +26,29 @@ BIN="$REPO_ROOT/build/ws/devel/lib/breast_tumour_registration"
 mkdir -p "$OUT"
 echo
 echo "[demo] 1/4 generating the synthetic phantom (thesis Sec. 5.2.1) into $OUT/scene"
-"$BIN/btr_phantom" --out "$OUT/scene" --youngs-modulus 3400 --cell-size 6 --quiet
-cp "$OUT/scene/scene.yaml" "$OUT/scene/scene_misaligned.yaml"
-echo "misalignment: {rotation_deg: [10, 0, 5], translation_mm: [5, -3, 4]}" >> "$OUT/scene/scene_misaligned.yaml"
-echo
-echo "[demo] 2/4 registering prone -> supine on files (rigid + landmark + surface) into $OUT/registration"
-"$BIN/btr_register" "$OUT/scene/scene_misaligned.yaml" --out "$OUT/registration" --preset balanced --quiet
+if [ "$FROM_LABELS" = 1 ]; then
+  "$BIN/btr_phantom" --out "$OUT/scene" --youngs-modulus 3400 --cell-size 6 --quiet --label-map "$OUT/labels"
+  echo
+  echo "[demo] 2/4 from the label map $OUT/labels/prone_labels.nii.gz: meshing it into a scene, then registering"
+  truth=()
+  for t in top middle bottom left right; do
+    truth+=(--truth "$t,$OUT/labels/tumour_${t}_prone.obj,$OUT/labels/tumour_${t}_supine.obj")
+  done
+  # The phantom's tissue is homogeneous (a stiffer tumour would be told by the label table) and
+  # its prone shape is the rest shape (--not-prone), as in its own scene.
+  printf "stiffness: {gland: 1, tumour: 1}\n" > "$OUT/labels/labels.yaml"
+  "$BIN/btr_scene_from_labels" "$OUT/labels/prone_labels.nii.gz" --labels "$OUT/labels/labels.yaml" --not-prone \
+    --prone-landmarks "$OUT/labels/prone_landmarks.mrk.json" --supine-landmarks "$OUT/labels/supine_landmarks.mrk.json" \
+    --supine-surface "$OUT/labels/supine_surface.obj" "${truth[@]}" --out "$OUT/label_scene"
+  "$BIN/btr_register" "$OUT/label_scene/scene.yaml" --out "$OUT/registration" --preset balanced --quiet
+else
+  "$BIN/btr_phantom" --out "$OUT/scene" --youngs-modulus 3400 --cell-size 6 --quiet
+  cp "$OUT/scene/scene.yaml" "$OUT/scene/scene_misaligned.yaml"
+  echo "misalignment: {rotation_deg: [10, 0, 5], translation_mm: [5, -3, 4]}" >> "$OUT/scene/scene_misaligned.yaml"
+  echo
+  echo "[demo] 2/4 registering prone -> supine on files (rigid + landmark + surface) into $OUT/registration"
+  "$BIN/btr_register" "$OUT/scene/scene_misaligned.yaml" --out "$OUT/registration" --preset balanced --quiet
+fi
 echo
 echo "[demo] 3/4 rendering the supine phantom as a depth camera sees it into $OUT/depth.bag"
 "$BIN/btr_make_bag" "$OUT/scene/scene.yaml" --out "$OUT/depth.bag" --frames 150

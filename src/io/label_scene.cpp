@@ -212,8 +212,9 @@ LabelSceneSummary write_scene_from_labels(const std::string& dir, const LabelVol
   scene["material"]["poisson_ratio"] = opt.poisson_ratio;
   scene["material"]["density"] = 1000.0;
   YAML::Node regions;
+  // Every tissue other than fat is a region, its stiffness 1 or not: the scene then carries the
+  // labels (the outputs to Slicer keep them).
   auto region = [&](const char* name, const std::vector<int>& labels, double ratio) {
-    if (ratio == 1.0) return;
     for (int l : labels) {
       YAML::Node r;
       r["name"] = std::string(name) + (labels.size() > 1 ? "_" + std::to_string(l) : "");

@@ -13,7 +13,9 @@
 #include "breast_tumour_registration/io/label_scene.h"
 #include "breast_tumour_registration/io/label_volume_io.h"
 #include "breast_tumour_registration/io/markups_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
+#include "breast_tumour_registration/simulation/registration_report.h"
 #include "breast_tumour_registration/simulation/label_phantom.h"
 #include "test_util.h"
 
@@ -269,6 +271,21 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
       }
   }
   EXPECT_TRUE(lb.reports.back().converged) << test::step_stops(lb);
+  // Results to Slicer: LPS files, the centroids as a point list that reads back where they are.
+  Scene ls = load_scene(dir + "/scene/scene.yaml");
+  RegistrationEngine engine(ls);
+  const RegistrationResult r = engine.solve(preset_options("balanced"));
+  const PreparedScene& prep = engine.prepare(preset_options("balanced"));
+  write_registration_outputs(dir + "/out", prep.scene, prep.model, r, 0);
+  const auto cps = read_markups(dir + "/out/slicer/tumour_centroids.mrk.json", PatientFrame::RAS);
+  ASSERT_EQ(cps.size(), r.tumours.size());
+  for (size_t i = 0; i < cps.size(); ++i) {
+    EXPECT_EQ(cps[i].label, r.tumours[i].name);
+    EXPECT_LT((cps[i].position - r.tumours[i].centroid).norm(), 1e-9);
+  }
+  const TetMeshFile vtk = read_tet_mesh_file(dir + "/out/slicer/registered.vtk", LengthUnit::Millimetre);
+  EXPECT_EQ(cell_labels(vtk, "label", "registered.vtk").size(), static_cast<size_t>(vtk.mesh.T.rows()));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/out/slicer/tumour_" + r.tumours[0].name + ".ply"));
 }
 
 TEST(LabelMapRoundTrip, ScenesTakeSlicerPointListsAndNameAFiducialOffTheSkinAsAFrameMistake) {
