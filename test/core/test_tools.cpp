@@ -38,6 +38,15 @@ void expect_refused(const std::string& args, const std::string& needle) {
   EXPECT_NE(r.output.find(needle), std::string::npos) << args << "\n" << r.output;
 }
 
+TEST(Tools, SceneFromLabelsRefusesBadInputWithExitCode2) {
+  const std::string dir = btr::test::temp_dir();
+  expect_refused("btr_scene_from_labels " + dir + "/missing.nii.gz -o " + dir + "/s", "missing.nii.gz: no such file");
+  btr::test::write_text(dir + "/plain.nrrd",
+                   "NRRD0004\ntype: uchar\ndimension: 3\nsizes: 2 2 2\nencoding: ascii\n\n0 1 0 1 0 1 0 1");
+  expect_refused("btr_scene_from_labels " + dir + "/plain.nrrd -o " + dir + "/s", "no patient space");
+  expect_refused("btr_scene_from_labels " + dir + "/plain.nrrd --cell-size nan -o " + dir + "/s", "--cell-size");
+}
+
 }  // namespace
 
 TEST(Tools, NumbersThatAreNotFiniteOrOutOfRangeExitWithCode2) {
