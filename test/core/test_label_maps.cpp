@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -110,6 +112,26 @@ TEST(LabelVolumeIo, FilesThatAreNoLabelMapSayWhatIsWrongAndWhatToDo) {
             }).find("Export to labelmap"),
             std::string::npos);
   EXPECT_NE(message_of([&] { read_label_volume(dir + "/missing.nii.gz"); }).find("no such file"), std::string::npos);
+  {  // A NIfTI-1 file whose qform and sform codes are 0: voxels without a place on the patient.
+    std::vector<char> hdr(352, 0);
+    auto put = [&](size_t at, const void* v, size_t n) { std::memcpy(hdr.data() + at, v, n); };
+    const int32_t sizeof_hdr = 348;
+    const int16_t dim[8] = {3, 2, 2, 2, 1, 1, 1, 1}, datatype = 2, bitpix = 8;
+    const float pixdim[8] = {1, 1, 1, 1, 0, 0, 0, 0}, vox_offset = 352;
+    put(0, &sizeof_hdr, 4);
+    put(40, dim, sizeof dim);
+    put(70, &datatype, 2);
+    put(72, &bitpix, 2);
+    put(76, pixdim, sizeof pixdim);
+    put(108, &vox_offset, 4);
+    put(344, "n+1", 4);
+    std::ofstream out(dir + "/noorient.nii", std::ios::binary);
+    out.write(hdr.data(), static_cast<std::streamsize>(hdr.size()));
+    const char data[8] = {0, 1, 0, 1, 0, 1, 0, 1};
+    out.write(data, 8);
+  }
+  EXPECT_NE(message_of([&] { read_label_volume(dir + "/noorient.nii"); }).find("no orientation (sform_code and qform_code are 0)"),
+            std::string::npos);
   test::write_text(dir + "/x.mha", "x");
   EXPECT_NE(message_of([&] { read_label_volume(dir + "/x.mha"); }).find("unknown label map format"), std::string::npos);
   test::write_text(dir + "/bad.nii", "not a nifti file at all");
@@ -188,6 +210,22 @@ TEST(LabelMesher, RefusesEmptyTumoursMissingMusclesAnisotropicVoxelsAndUnknownLa
   table.muscle = 4;
   table.gland = {1};
   EXPECT_NE(message_of([&] { check_label_table(table, v, "breast.nii.gz"); }).find("label 1 is both fat and gland"), std::string::npos);
+}
+
+TEST(LabelTable, SegmentNamesStandForLabelValuesAndUnknownKeysOrNamesAreNamed) {
+  const std::string dir = test::temp_dir();
+  LabelVolume v = synthetic_breast(0.002);
+  v.names = {{1, "Adipose"}, {3, "Lesion"}, {4, "Pectoralis"}};
+  test::write_text(dir + "/t.yaml", "fat: [adipose]\ntumour: [Lesion]\nmuscle: Pectoralis\nstiffness: {tumour: 8}\n");
+  const LabelTable t = read_label_table(dir + "/t.yaml", v);
+  EXPECT_EQ(t.fat, std::vector<int>{1});
+  EXPECT_EQ(t.tumour, std::vector<int>{3});
+  EXPECT_EQ(t.muscle, 4);
+  EXPECT_EQ(t.tumour_stiffness, 8);
+  test::write_text(dir + "/u.yaml", "tumor: [3]\n");
+  EXPECT_NE(message_of([&] { read_label_table(dir + "/u.yaml", v); }).find("did you mean tumour"), std::string::npos);
+  test::write_text(dir + "/w.yaml", "tumour: [Cyst]\n");
+  EXPECT_NE(message_of([&] { read_label_table(dir + "/w.yaml", v); }).find("segments: Adipose, Lesion, Pectoralis"), std::string::npos);
 }
 
 TEST(Markups, SlicerPointListsAreReadInTheFrameAskedForAndMatchedByLabel) {
