@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Renders what an OR user sees in RViz, headless: the demo (phantom scene, replayed depth bag,
-# registration node, one service call) with rviz:=true under Xvfb, then a screenshot of the
+# registration node, one service call with the linearised uncertainty) with rviz:=true under Xvfb, then a screenshot of the
 # X screen after the registration has been published. Writes out/rviz/rviz.png (BTR_OUT to
 # override) and fails if the picture is blank. Installs rviz, xvfb and imagemagick when missing.
 set -euo pipefail
@@ -37,7 +37,7 @@ xvfb-run -a -s "-screen 0 1100x720x24" bash -c '
   launch_pid=$!
   for _ in $(seq 1 60); do rosnode list > /dev/null 2>&1 && break; sleep 0.5; done
   rc=0
-  timeout 180 "$BIN/btr_demo_client" _truth:="$OUT/depth.bag.truth.yaml" _preset:=balanced __name:=demo_client \
+  timeout 180 "$BIN/btr_demo_client" _truth:="$OUT/depth.bag.truth.yaml" _preset:=balanced _uncertainty:=linear __name:=demo_client \
     > "$OUT/client.log" 2>&1 || rc=$?
   sleep 4  # RViz draws the latched markers and a few more clouds
   import -window root "$OUT/rviz.png"

@@ -2,6 +2,9 @@
 
 #include <sensor_msgs/point_cloud2_iterator.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -153,6 +156,37 @@ visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& fr
       p.z = s.V(s.F(f, k), 2);
       mk.points.push_back(p);
     }
+  return mk;
+}
+
+visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& cov, const std::string& frame_id,
+                                               const std::string& ns, int id, float r, float g, float b, float a) {
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (cov + cov.transpose()));
+  Mat3 axes = eig.eigenvectors();
+  if (axes.determinant() < 0) axes.col(2) *= -1;  // a rotation
+  const Eigen::Quaterniond q(axes);
+  visualization_msgs::Marker mk;
+  mk.header.frame_id = frame_id;
+  mk.ns = ns;
+  mk.id = id;
+  mk.type = visualization_msgs::Marker::SPHERE;
+  mk.action = visualization_msgs::Marker::ADD;
+  mk.pose.position.x = centre.x();
+  mk.pose.position.y = centre.y();
+  mk.pose.position.z = centre.z();
+  mk.pose.orientation.w = q.w();
+  mk.pose.orientation.x = q.x();
+  mk.pose.orientation.y = q.y();
+  mk.pose.orientation.z = q.z();
+  constexpr double kChi2_3_95 = 7.8147;
+  const Vec3 lambda = eig.eigenvalues().cwiseMax(0.0);
+  mk.scale.x = 2 * std::sqrt(kChi2_3_95 * lambda[0]);
+  mk.scale.y = 2 * std::sqrt(kChi2_3_95 * lambda[1]);
+  mk.scale.z = 2 * std::sqrt(kChi2_3_95 * lambda[2]);
+  mk.color.r = r;
+  mk.color.g = g;
+  mk.color.b = b;
+  mk.color.a = a;
   return mk;
 }
 

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   pnh.param("truth", truth_file, truth_file);
   pnh.param("preset", preset, preset);
   pnh.param("timeout", timeout, timeout);
+  std::string uncertainty;  // "" / none, or linear: each tumour also gets its 95 % region
+  pnh.param("uncertainty", uncertainty, uncertainty);
   if (!ros::service::waitForService(service, ros::Duration(timeout))) {
     ROS_ERROR("service %s did not appear within %.0f s", service.c_str(), timeout);
     return 1;
@@ -26,6 +28,7 @@ int main(int argc, char** argv) {
   breast_tumour_registration::Register srv;
   srv.request.preset = preset;
   srv.request.use_latest_cloud = true;
+  srv.request.uncertainty = uncertainty;
   const ros::WallTime start = ros::WallTime::now();
   // The node answers "not yet" until a cloud has arrived and the model is tracked.
   while (ros::ok()) {
@@ -53,6 +56,7 @@ int main(int argc, char** argv) {
                                      std::pow(t.centroid.point.z - c[2], 2));
           std::printf(", error %.2f mm against the truth", e * 1e3);
         }
+        if (t.has_uncertainty) std::printf(", 95 %% radius %.2f mm (experimental)", t.radius_95 * 1e3);
         std::printf("\n");
       }
       return failures;

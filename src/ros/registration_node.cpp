@@ -99,6 +99,7 @@ RegistrationNode::RegistrationNode(ros::NodeHandle nh, ros::NodeHandle pnh)
   mesh_pub_ = pnh_.advertise<shape_msgs::Mesh>("tumour_mesh", 1, true);
   marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("tumour_marker", 10, true);
   breast_marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("breast_marker", 1, true);
+  status_marker_pub_ = pnh_.advertise<visualization_msgs::Marker>("status_marker", 1, true);
   result_pub_ = pnh_.advertise<breast_tumour_registration::RegistrationResult>("result", 1, true);
   if (parameters_ok) {
     load_scene();
@@ -163,6 +164,22 @@ void RegistrationNode::publish_status(uint8_t level, const std::string& message)
   st.message = message;
   st.hardware_id = params_.scene;
   status_pub_.publish(st);
+  // The same as text beside the model, for RViz (white, yellow for a warning, red for an error).
+  visualization_msgs::Marker mk;
+  mk.header.frame_id = params_.model_frame;
+  mk.header.stamp = ros::Time(0);  // the latest model pose
+  mk.ns = "status";
+  mk.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
+  mk.action = visualization_msgs::Marker::ADD;
+  mk.pose.position.z = 0.10;
+  mk.pose.orientation.w = 1.0;
+  mk.scale.z = 0.006;
+  mk.color.r = 1.0f;
+  mk.color.g = level == diagnostic_msgs::DiagnosticStatus::ERROR ? 0.3f : 1.0f;
+  mk.color.b = level == diagnostic_msgs::DiagnosticStatus::OK ? 1.0f : 0.3f;
+  mk.color.a = 1.0f;
+  mk.text = message;
+  status_marker_pub_.publish(mk);
 }
 
 void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
@@ -374,9 +391,15 @@ void RegistrationNode::publish_result(const RegistrationResult& r, const Registr
       tm.radius_95 = t.uncertainty->radius_95;
     }
     out.tumours.push_back(tm);
-    auto mk = ros_conv::to_marker(t.registered, frame, "tumour", id++, 0.9f, 0.2f, 0.2f, 0.9f);
+    auto mk = ros_conv::to_marker(t.registered, frame, "tumour", id, 0.9f, 0.2f, 0.2f, 0.9f);
     mk.header.stamp = now;
     marker_pub_.publish(mk);
+    if (t.uncertainty) {  // the centroid's 95 % region, translucent yellow
+      auto em = ros_conv::to_ellipsoid_marker(t.centroid, t.uncertainty->covariance, frame, "uncertainty", id, 1.0f, 0.85f, 0.2f, 0.35f);
+      em.header.stamp = now;
+      marker_pub_.publish(em);
+    }
+    ++id;
     geometry_msgs::TransformStamped tf;
     tf.header = out.header;
     tf.child_frame_id = "tumour_" + t.name;

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <limits>
 
@@ -10,6 +12,27 @@
 #include "breast_tumour_registration/ros/converters.h"
 
 using namespace btr;
+
+TEST(Converters, TheUncertaintyEllipsoidHasTheCovariancesAxesAndDirections) {
+  // Standard deviations 3, 1 and 2 mm along R's axes, R a turn of 30 deg about z.
+  const double c = std::cos(M_PI / 6), s = std::sin(M_PI / 6);
+  btr::Mat3 R;
+  R << c, -s, 0, s, c, 0, 0, 0, 1;
+  const btr::Vec3 sd(0.003, 0.001, 0.002);
+  const btr::Mat3 cov = R * sd.cwiseAbs2().asDiagonal() * R.transpose();
+  const auto mk = btr::ros_conv::to_ellipsoid_marker(btr::Vec3(0.1, 0.2, 0.3), cov, "world", "u", 0, 1, 1, 0, 0.5f);
+  EXPECT_EQ(mk.type, visualization_msgs::Marker::SPHERE);
+  EXPECT_DOUBLE_EQ(mk.pose.position.y, 0.2);
+  // Eigenvalues ascending: 1, 2, 3 mm; each axis 2 sqrt(7.8147) sd.
+  const double k = 2 * std::sqrt(7.8147);
+  EXPECT_NEAR(mk.scale.x, k * 0.001, 1e-12);
+  EXPECT_NEAR(mk.scale.y, k * 0.002, 1e-12);
+  EXPECT_NEAR(mk.scale.z, k * 0.003, 1e-12);
+  // The marker's z axis (the largest spread) is R's x axis, up to sign.
+  const Eigen::Quaterniond q(mk.pose.orientation.w, mk.pose.orientation.x, mk.pose.orientation.y, mk.pose.orientation.z);
+  EXPECT_NEAR(std::abs((q * btr::Vec3::UnitZ()).dot(R.col(0))), 1.0, 1e-9);
+  EXPECT_NEAR(q.norm(), 1.0, 1e-12);
+}
 
 TEST(Converters, OrganizedCloudKeepsItsLayoutOrDropsNaN) {
   Points P(6, 3);

@@ -37,6 +37,12 @@ SurfaceMesh from_mesh(const shape_msgs::Mesh& m);
 visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& frame_id, const std::string& ns, int id,
                                      float r, float g, float b, float a);
 
+/// The 95 % region of a point with Gaussian covariance `cov` [m^2] about `centre`: a SPHERE
+/// marker scaled and turned into the ellipsoid whose axes are 2 sqrt(chi2_3(0.95) lambda_i)
+/// along the eigenvectors (chi2_3(0.95) = 7.815).
+visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& cov, const std::string& frame_id,
+                                               const std::string& ns, int id, float r, float g, float b, float a);
+
 geometry_msgs::Transform to_transform(const Rigid& T);
 Rigid from_transform(const geometry_msgs::Transform& t);
 

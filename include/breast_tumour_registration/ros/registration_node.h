@@ -88,7 +88,7 @@ class RegistrationNode {
   ros::CallbackQueue service_queue_;
   std::unique_ptr<ros::AsyncSpinner> service_spinner_;
   ros::ServiceServer register_srv_;
-  ros::Publisher mesh_pub_, marker_pub_, breast_marker_pub_, result_pub_, status_pub_;
+  ros::Publisher mesh_pub_, marker_pub_, breast_marker_pub_, result_pub_, status_pub_, status_marker_pub_;
 };
 
 }  // namespace btr
