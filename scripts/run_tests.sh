@@ -17,8 +17,10 @@ build_rc=$?
 
 # The fuzz targets (test/fuzz), each for a bounded time; their JUnit file joins the others.
 # BTR_FUZZ_SECONDS=0 skips them (the sanitizer workspace, which runs the same tests again).
+# A fuzz build that fails writes no JUnit file, so its failure is counted here.
+fuzz_rc=0
 if [ "${BTR_FUZZ_SECONDS:-30}" -gt 0 ]; then
-  bash "$REPO_ROOT/scripts/run_fuzz.sh" "${BTR_FUZZ_SECONDS:-30}" "$WS/build/test_results/btr_fuzz/fuzz.xml"
+  bash "$REPO_ROOT/scripts/run_fuzz.sh" "${BTR_FUZZ_SECONDS:-30}" "$WS/build/test_results/btr_fuzz/fuzz.xml" || fuzz_rc=$?
 fi
 
 summary="$(catkin_test_results build/test_results 2>&1)"
@@ -45,7 +47,7 @@ print(total, failed)
 PY
 )
 passed=$((total - failed))
-if [ "$build_rc" -ne 0 ] || [ "$results_rc" -ne 0 ] || [ "$total" -eq 0 ]; then
+if [ "$build_rc" -ne 0 ] || [ "$results_rc" -ne 0 ] || [ "$fuzz_rc" -ne 0 ] || [ "$total" -eq 0 ]; then
   [ "$failed" -eq 0 ] && failed=1
   echo "$passed passed, $failed failed"
   exit 1
