@@ -33,7 +33,9 @@ for r in $(seq 1 "$REPEATS"); do
 done
 grep -E "tetrahedra" "$OUT/mesh.log"
 grep -E "centroid error" "$OUT/register.log" | sed 's/, volume ratio.*centroid error/: centroid error/'
+median() { sort -n | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
 for name in mesh register; do
-  awk -v n="$name" '$1 == n { w[++k] = $2; m[k] = $3 } END {
-    asort(w); asort(m); printf "median %s: %.2f s, %d MB peak (%d runs)\n", n, w[int((k + 1) / 2)], m[int((k + 1) / 2)], k }' "$OUT/runs.txt"
+  wall=$(awk -v n="$name" '$1 == n { print $2 }' "$OUT/runs.txt" | median)
+  rss=$(awk -v n="$name" '$1 == n { print $3 }' "$OUT/runs.txt" | median)
+  echo "median $name: $wall s, $rss MB peak ($REPEATS runs)"
 done
