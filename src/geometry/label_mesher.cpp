@@ -13,13 +13,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstring>
-#include <numeric>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 
 #include "breast_tumour_registration/base/errors.h"
-#include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/tetrahedralize.h"
 #include "breast_tumour_registration/geometry/validation.h"
 

@@ -5,7 +5,10 @@
 //
 // What comes out, in RAS [m] (label_volume.h):
 // - the tetrahedra of the tissue labels (fat, gland, skin, tumour), each with its label;
-// - the chest wall: the vertices on the interface with the muscle label, or, without one,
+// - the chest wall: the corners of the facets on the interface with the muscle label (along the
+//   rim a few of them lie on the skin, up to 2.5 mm above the interface at 7 mm cells; fixing
+//   only the vertices Mesh_3 placed on the interface itself inverted a rim element in the
+//   surface step on every mesh size tried, BENCHMARKS.md), or, without one,
 //   the posterior-most boundary vertices (within half a cell of the most posterior one
 //   along `posterior`);
 // - every tumour as a closed surface, outward: each tumour label is meshed again on its own in
