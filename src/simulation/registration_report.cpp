@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/simulation/registration_report.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +11,7 @@
 #include <sstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/io/cross_section_image.h"
 #include "breast_tumour_registration/io/markups_io.h"
@@ -178,6 +181,18 @@ void prepare_output_folder(const std::string& dir) {
   fs::remove(probe, ec);
 }
 
+SurfaceMesh uncertainty_ellipsoid(const Vec3& centre, const Mat3& covariance) {
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (covariance + covariance.transpose()));
+  constexpr double kChi2_3_95 = 7.8147;  // the 95 % quantile of chi-squared with 3 degrees of freedom
+  const Vec3 semi = (kChi2_3_95 * eig.eigenvalues().cwiseMax(0.0)).cwiseSqrt();
+  Mat3 axes = eig.eigenvectors();
+  if (axes.determinant() < 0) axes.col(2) *= -1;  // a rotation, so that the surface stays outward
+  SurfaceMesh s = make_icosphere(Vec3::Zero(), 1.0, 2);
+  for (Eigen::Index i = 0; i < s.V.rows(); ++i)
+    s.V.row(i) = (centre + axes * semi.cwiseProduct(s.V.row(i).transpose())).transpose();
+  return s;
+}
+
 std::vector<std::string> write_registration_outputs(const std::string& dir, const Scene& scene,
                                                     const RegistrationModel& model, const RegistrationResult& r,
                                                     double prepare_seconds) {
@@ -240,6 +255,12 @@ std::vector<std::string> write_registration_outputs(const std::string& dir, cons
     outlines.push_back({&r.tumours[i].registered, {235, 60, 60}, 4});
     if (scene.tumours[i].supine_ground_truth) outlines.push_back({&*scene.tumours[i].supine_ground_truth, {60, 220, 90}, 1});
   }
+  // The 95 % region of each centroid (when the uncertainty ran): the ellipsoid of its covariance.
+  std::vector<SurfaceMesh> regions;
+  regions.reserve(r.tumours.size());
+  for (const auto& t : r.tumours)
+    if (t.uncertainty) regions.push_back(uncertainty_ellipsoid(t.centroid, t.uncertainty->covariance));
+  for (const auto& e : regions) outlines.push_back({&e, {250, 210, 40}, 2});
   const double y0 = r.tumours.empty() ? skin.V.col(1).mean() : r.tumours[0].centroid.y();
   write_cross_section_png(path("cross_section.png"), outlines, y0);
   return files;

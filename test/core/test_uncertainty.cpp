@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/simulation/registration_report.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "test_util.h"
@@ -199,4 +200,20 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
   expect_throw_with<InputError>([&] { engine.sample_uncertainty(o, u, 1, 3, nominal); }, "at least 2 samples");
   EXPECT_EQ(percentile_95({3, 1, 2}), 3.0);
   EXPECT_EQ(percentile_95({}), 0.0);
+}
+
+TEST(UncertaintyPicture, TheRegionDrawnIsTheCovariances95PercentEllipsoid) {
+  // Standard deviations 1, 2, 3 mm along turned axes: semi-axes sqrt(7.8147) times those.
+  const Mat3 R = Eigen::AngleAxisd(0.4, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  const Vec3 sd(0.001, 0.002, 0.003), c(0.01, -0.02, 0.05);
+  const SurfaceMesh e = uncertainty_ellipsoid(c, R * sd.cwiseAbs2().asDiagonal() * R.transpose());
+  const double k = std::sqrt(7.8147);
+  // An icosphere of 320 faces holds 0.966 of its sphere's volume; the surface stays outward.
+  const double expected = 4.0 / 3.0 * M_PI * k * sd[0] * k * sd[1] * k * sd[2];
+  EXPECT_NEAR(enclosed_volume(e) / expected, 0.966, 0.005);
+  EXPECT_LT((volume_centroid(e) - c).norm(), 1e-9);
+  double longest = 0;
+  for (Eigen::Index i = 0; i < e.V.rows(); ++i) longest = std::max(longest, (e.V.row(i).transpose() - c).norm());
+  EXPECT_LE(longest, k * sd[2] * (1 + 1e-9));  // no vertex beyond the major semi-axis,
+  EXPECT_GT(longest, 0.97 * k * sd[2]);         // and one near it
 }

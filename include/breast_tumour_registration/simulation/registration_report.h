@@ -17,6 +17,10 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
 void prepare_output_folder(const std::string& dir);
 
 /// Writes every output into `dir` (created); returns the list of files written.
+/// The 95 % region of a Gaussian point (centre, covariance [m^2]) as a closed surface: the
+/// ellipsoid with semi-axes sqrt(chi2_3(0.95) lambda_i) along the eigenvectors.
+SurfaceMesh uncertainty_ellipsoid(const Vec3& centre, const Mat3& covariance);
+
 std::vector<std::string> write_registration_outputs(const std::string& dir, const Scene& scene,
                                                     const RegistrationModel& model, const RegistrationResult& r,
                                                     double prepare_seconds);
