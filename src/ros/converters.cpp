@@ -2,7 +2,6 @@
 
 #include <sensor_msgs/point_cloud2_iterator.h>
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -10,6 +9,7 @@
 #include <limits>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/registration/tumour_uncertainty.h"
 
 namespace btr::ros_conv {
 
@@ -161,10 +161,8 @@ visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& fr
 
 visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& cov, const std::string& frame_id,
                                                const std::string& ns, int id, float r, float g, float b, float a) {
-  const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (cov + cov.transpose()));
-  Mat3 axes = eig.eigenvectors();
-  if (axes.determinant() < 0) axes.col(2) *= -1;  // a rotation
-  const Eigen::Quaterniond q(axes);
+  const Ellipsoid95 e = ellipsoid_95(cov);
+  const Eigen::Quaterniond q(e.axes);
   visualization_msgs::Marker mk;
   mk.header.frame_id = frame_id;
   mk.ns = ns;
@@ -178,11 +176,9 @@ visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& c
   mk.pose.orientation.x = q.x();
   mk.pose.orientation.y = q.y();
   mk.pose.orientation.z = q.z();
-  constexpr double kChi2_3_95 = 7.8147;
-  const Vec3 lambda = eig.eigenvalues().cwiseMax(0.0);
-  mk.scale.x = 2 * std::sqrt(kChi2_3_95 * lambda[0]);
-  mk.scale.y = 2 * std::sqrt(kChi2_3_95 * lambda[1]);
-  mk.scale.z = 2 * std::sqrt(kChi2_3_95 * lambda[2]);
+  mk.scale.x = 2 * e.semi_axes[0];
+  mk.scale.y = 2 * e.semi_axes[1];
+  mk.scale.z = 2 * e.semi_axes[2];
   mk.color.r = r;
   mk.color.g = g;
   mk.color.b = b;

@@ -1,7 +1,5 @@
 #include "breast_tumour_registration/simulation/registration_report.h"
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -182,14 +180,10 @@ void prepare_output_folder(const std::string& dir) {
 }
 
 SurfaceMesh uncertainty_ellipsoid(const Vec3& centre, const Mat3& covariance) {
-  const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (covariance + covariance.transpose()));
-  constexpr double kChi2_3_95 = 7.8147;  // the 95 % quantile of chi-squared with 3 degrees of freedom
-  const Vec3 semi = (kChi2_3_95 * eig.eigenvalues().cwiseMax(0.0)).cwiseSqrt();
-  Mat3 axes = eig.eigenvectors();
-  if (axes.determinant() < 0) axes.col(2) *= -1;  // a rotation, so that the surface stays outward
+  const Ellipsoid95 e = ellipsoid_95(covariance);
   SurfaceMesh s = make_icosphere(Vec3::Zero(), 1.0, 2);
   for (Eigen::Index i = 0; i < s.V.rows(); ++i)
-    s.V.row(i) = (centre + axes * semi.cwiseProduct(s.V.row(i).transpose())).transpose();
+    s.V.row(i) = (centre + e.axes * e.semi_axes.cwiseProduct(s.V.row(i).transpose())).transpose();
   return s;
 }
 
