@@ -10,7 +10,10 @@
 //   skin: []
 //   ignore: []          # other structures, left outside the model (any label not listed
 //                       # anywhere is an error: the table must account for every label)
-//   stiffness: {gland: 2, tumour: 5, skin: 1}   # relative to fat, i.e. to material.youngs_modulus
+//   stiffness: {gland: 1, tumour: 1, skin: 1}   # relative to fat, i.e. to material.youngs_modulus;
+//                       # 1 (homogeneous, the thesis's model) unless the table says otherwise, as a
+//                       # stiffer tumour is off in a scene unless given. Published ratios are about 2
+//                       # for gland and 5 to 10 for tumours (issue 13); a wrong ratio costs (BENCHMARKS.md)
 //
 // The scene is written in RAS millimetres (`patient_frame: RAS`), the supine gravity along
 // posterior and, for a prone image, the prone gravity along anterior (which plans `unload`).
@@ -29,7 +32,7 @@ namespace btr {
 struct LabelTable {
   std::vector<int> fat = {1}, gland = {2}, tumour = {3}, skin = {}, ignore = {};
   int muscle = 4;  ///< -1: none
-  double gland_stiffness = 2, tumour_stiffness = 5, skin_stiffness = 1;  ///< relative to fat
+  double gland_stiffness = 1, tumour_stiffness = 1, skin_stiffness = 1;  ///< relative to fat
 };
 
 /// Reads a label table; entries may be label values or segment names of `v` (a .seg.nrrd's
