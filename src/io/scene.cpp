@@ -201,6 +201,10 @@ Scene load_scene_fields(const std::string& path) {
   if (supine && supine["chest_ring"]) s.supine_rigid = open_surface(supine["chest_ring"], "supine.chest_ring");
   if (root["chest_ring"]) s.prone_rigid = open_surface(root["chest_ring"], "chest_ring");
 
+  // The patient frame of the scene's coordinates (RAS or LPS), when it says: point lists are
+  // converted to it, and the outputs for 3D Slicer are written from it.
+  if (root["patient_frame"])
+    s.patient_frame = c.load("patient_frame", [&] { return parse_patient_frame(c.text(root["patient_frame"], "patient_frame"), "patient_frame"); });
   // Landmarks: Slicer point lists matched by label, or a file of vertex index pairs.
   if (root["landmarks"] && root["landmarks"].IsMap()) {
     const YAML::Node lm = root["landmarks"];
@@ -208,8 +212,7 @@ Scene load_scene_fields(const std::string& path) {
     if (!root["patient_frame"])
       c.fail("patient_frame", "missing: with Slicer point lists the scene must say in which patient frame its own coordinates are "
                               "(patient_frame: RAS or LPS; btr_scene_from_labels writes RAS)");
-    const PatientFrame frame = c.load("patient_frame", [&] { return parse_patient_frame(c.text(root["patient_frame"], "patient_frame"), "patient_frame"); });
-    s.patient_frame = frame;
+    const PatientFrame frame = *s.patient_frame;
     const auto prone_pts = c.load("landmarks.prone", [&] { return read_markups(c.path_of(lm["prone"], "landmarks.prone"), frame); });
     const auto supine_pts = c.load("landmarks.supine", [&] { return read_markups(c.path_of(lm["supine"], "landmarks.supine"), frame); });
     const MatchedPoints m = match_by_label(prone_pts, supine_pts);

@@ -348,6 +348,11 @@ TEST(LabelMapRoundTrip, ScenesTakeSlicerPointListsAndNameAFiducialOffTheSkinAsAF
     EXPECT_LT((ok.landmark_anchors[i].position(ok.prone.V) - s.landmark_anchors[i].position(s.prone.V)).norm(), 1e-6);
     EXPECT_LT((ok.landmark_supine.row(static_cast<Eigen::Index>(i)) - s.landmark_supine.row(static_cast<Eigen::Index>(i))).norm(), 1e-9);
   }
+  // patient_frame is read with or without point lists (the Slicer outputs need it); a bad one is named.
+  test::write_text(src + "/scene_frame_only.yaml", test::scene_text(src) + "patient_frame: LPS\n");
+  EXPECT_EQ(load_scene(src + "/scene_frame_only.yaml").patient_frame, PatientFrame::LPS);
+  test::write_text(src + "/scene_frame_bad.yaml", test::scene_text(src) + "patient_frame: RAI\n");
+  EXPECT_NE(message_of([&] { load_scene(src + "/scene_frame_bad.yaml"); }).find("field 'patient_frame'"), std::string::npos);
   test::write_text(src + "/scene_markups_noframe.yaml", text + lists);
   EXPECT_NE(message_of([&] { load_scene(src + "/scene_markups_noframe.yaml"); }).find("field 'patient_frame': missing"), std::string::npos);
   // A prone fiducial 30 mm off the skin: most often a list in another frame than it says.
