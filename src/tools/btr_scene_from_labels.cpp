@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/io/label_scene.h"
 #include "breast_tumour_registration/io/label_volume_io.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
 
 using namespace btr;
 
@@ -26,7 +27,9 @@ int main(int argc, char** argv) {
   app.add_option("label_map", label_map, "prone label map: .nii, .nii.gz, .nrrd, .nhdr or .seg.nrrd")->required();
   app.add_option("--labels", table_path, "label table (YAML): which label value or segment name is which tissue");
   app.add_option("-o,--out", out_dir, "scene folder (created)")->capture_default_str();
-  app.add_option("--cell-size", cell_mm, "tetrahedron size bound [mm] (7: the balanced preset's, which then simulates the mesh as it is)")->capture_default_str()->check(btr::cli::positive());
+  auto* cell_opt = app.add_option("--cell-size", cell_mm, "tetrahedron size bound [mm]; default: the preset's simulation mesh "
+                                                            "(fast 9, balanced 7; accurate 7), which the preset then simulates as it is")
+                       ->check(btr::cli::positive());
   app.add_option("--tumour-facet-size", tumour_facet_mm, "facet size bound on the tumours' surfaces [mm]")
       ->capture_default_str()
       ->check(btr::cli::positive());
@@ -45,6 +48,11 @@ int main(int argc, char** argv) {
   app.add_flag("--no-features", no_features, "do not protect the lines where three labels meet");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
+    // The preset's own mesh size, so that the registration simulates this mesh as it is.
+    if (!cell_opt->count()) {
+      const double preset_cell = preset_options(preset).simulation_cell_size;
+      cell_mm = preset_cell > 0 ? preset_cell * 1e3 : 7.0;
+    }
     const LabelVolume v = read_label_volume(label_map);
     const LabelTable table = table_path.empty() ? LabelTable{} : read_label_table(table_path, v);
     LabelSceneOptions o;
