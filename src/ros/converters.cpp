@@ -9,7 +9,7 @@
 #include <limits>
 
 #include "breast_tumour_registration/base/errors.h"
-#include "breast_tumour_registration/registration/tumour_uncertainty.h"
+#include "breast_tumour_registration/geometry/confidence_ellipsoid.h"
 
 namespace btr::ros_conv {
 

@@ -118,12 +118,4 @@ double percentile_95(std::vector<double> distances);
 /// quadrature over the eigenvalues: exact to 1e-4 relative).
 double radius_95(const Mat3& covariance);
 
-/// The 95 % region of a Gaussian point as an ellipsoid: `axes` a rotation whose columns are the
-/// covariance's eigenvectors (eigenvalues ascending), semi-axes sqrt(chi2_3(0.95) lambda_i) [m].
-struct Ellipsoid95 {
-  Mat3 axes = Mat3::Identity();
-  Vec3 semi_axes = Vec3::Zero();
-};
-Ellipsoid95 ellipsoid_95(const Mat3& covariance);
-
 }  // namespace btr
