@@ -6,14 +6,14 @@
 #include <cctype>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 
 namespace btr {
 
 double metres_per_unit(LengthUnit u) { return u == LengthUnit::Metre ? 1.0 : 1e-3; }
 
 LengthUnit parse_length_unit(const std::string& s) {
-  std::string t = s;
-  std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string t = lower_case(s);
   if (t == "m" || t == "metre" || t == "meter" || t == "metres" || t == "meters") return LengthUnit::Metre;
   if (t == "mm" || t == "millimetre" || t == "millimeter" || t == "millimetres" || t == "millimeters")
     return LengthUnit::Millimetre;

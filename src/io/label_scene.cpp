@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/io/index_io.h"
 #include "breast_tumour_registration/io/markups_io.h"
@@ -20,11 +22,6 @@ namespace fs = std::filesystem;
 namespace {
 const std::vector<std::string> kTableKeys = {"fat",     "gland",        "tumour",          "muscle",        "skin", "ignore",
                                              "stiffness", "stiffness.gland", "stiffness.tumour", "stiffness.skin"};
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 // A label value, or a segment name of the volume.
 int label_value(const YamlFields& c, const YAML::Node& n, const std::string& field, const LabelVolume& v) {
@@ -39,7 +36,7 @@ int label_value(const YamlFields& c, const YAML::Node& n, const std::string& fie
   } catch (const std::logic_error&) {
   }
   for (const auto& [l, name] : v.names)
-    if (lower(name) == lower(s)) return l;
+    if (lower_case(name) == lower_case(s)) return l;
   std::string known;
   for (const auto& [l, name] : v.names) known += (known.empty() ? "" : ", ") + name;
   c.fail(field, "'" + s + "' is neither a label value nor a segment name of the label map" +
@@ -50,7 +47,7 @@ std::vector<int> label_list(const YamlFields& c, const YAML::Node& n, const std:
   std::vector<int> out;
   if (n.IsSequence())
     for (const auto& e : n) out.push_back(label_value(c, e, field, v));
-  else if (n.IsScalar() && lower(n.as<std::string>()) != "none")
+  else if (n.IsScalar() && lower_case(n.as<std::string>()) != "none")
     out.push_back(label_value(c, n, field, v));
   return out;
 }
@@ -130,8 +127,10 @@ LabelSceneSummary write_scene_from_labels(const std::string& dir, const LabelVol
     if (match_by_label(prone_pts, supine_pts).labels.empty())
       throw InputError(opt.prone_landmarks + " and " + opt.supine_landmarks + ": no label is in both point lists");
   }
-  if (!opt.supine_surface.empty()) read_surface(opt.supine_surface, supine_units);
-  if (!opt.supine_cloud.empty()) read_point_cloud(opt.supine_cloud, supine_units);
+  std::optional<SurfaceMesh> supine_surface;
+  std::optional<Points> supine_cloud;
+  if (!opt.supine_surface.empty()) supine_surface = read_surface(opt.supine_surface, supine_units);
+  if (!opt.supine_cloud.empty()) supine_cloud = read_point_cloud(opt.supine_cloud, supine_units);
 
   check_label_table(table, v, opt.mesh.source);
   LabelMeshOptions mo = opt.mesh;
@@ -189,20 +188,22 @@ LabelSceneSummary write_scene_from_labels(const std::string& dir, const LabelVol
     fs::copy_file(from, path(as), fs::copy_options::overwrite_existing);
     return as;
   };
-  auto markups_ext = [](const std::string& f) { return lower(f).size() > 9 && lower(f).substr(lower(f).size() - 9) == ".mrk.json" ? std::string(".mrk.json") : fs::path(f).extension().string(); };
+  auto markups_ext = [](const std::string& f) {
+    return ends_with(lower_case(f), ".mrk.json") ? std::string(".mrk.json") : fs::path(f).extension().string();
+  };
   if (!prone_pts.empty()) {
     scene["landmarks"]["prone"] = copy(opt.prone_landmarks, "prone_landmarks" + markups_ext(opt.prone_landmarks));
     scene["landmarks"]["supine"] = copy(opt.supine_landmarks, "supine_landmarks" + markups_ext(opt.supine_landmarks));
   }
-  if (!opt.supine_surface.empty() || !opt.supine_cloud.empty()) {
+  if (supine_surface || supine_cloud) {
     // Supine files in another unit are rewritten in millimetres, the scene's unit.
-    if (!opt.supine_surface.empty()) {
+    if (supine_surface) {
       const std::string as = "supine_surface" + file_extension(opt.supine_surface);
-      write_surface(path(as), read_surface(opt.supine_surface, supine_units), mmu);
+      write_surface(path(as), *supine_surface, mmu);
       scene["supine"]["surface"] = as;
     } else {
       const std::string as = "supine_cloud.xyz";
-      const Points c = read_point_cloud(opt.supine_cloud, supine_units);
+      const Points& c = *supine_cloud;
       std::ofstream out(path(as));
       for (Eigen::Index i = 0; i < c.rows(); ++i) out << c(i, 0) * 1e3 << " " << c(i, 1) * 1e3 << " " << c(i, 2) * 1e3 << "\n";
       scene["supine"]["cloud"] = as;
@@ -223,11 +224,11 @@ LabelSceneSummary write_scene_from_labels(const std::string& dir, const LabelVol
       regions.push_back(r);
     }
   };
-  const std::vector<long> hist = label_histogram(v);
-  auto present = [&](const std::vector<int>& ls) {
+  const std::set<int> meshed_labels(m.labels.begin(), m.labels.end());
+  auto present = [&](const std::vector<int>& ls) {  // the labels some tetrahedron carries
     std::vector<int> out;
     for (int l : ls)
-      if (hist[l] > 0 && std::count(m.labels.begin(), m.labels.end(), l) > 0) out.push_back(l);
+      if (meshed_labels.count(l)) out.push_back(l);
     return out;
   };
   region("gland", present(table.gland), table.gland_stiffness);

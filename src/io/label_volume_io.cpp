@@ -11,23 +11,15 @@
 #include <sstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 
 namespace btr {
 namespace {
 
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 enum class Format { Nifti, Nrrd };
 
 Format format_of(const std::string& path) {
-  const std::string p = lower(path);
+  const std::string p = lower_case(path);
   if (ends_with(p, ".nii") || ends_with(p, ".nii.gz")) return Format::Nifti;
   if (ends_with(p, ".nrrd") || ends_with(p, ".nhdr")) return Format::Nrrd;
   throw InputError(path + ": unknown label map format (expected .nii, .nii.gz, .nrrd, .nhdr or .seg.nrrd)");
@@ -191,7 +183,7 @@ double nrrd_unit(const Nrrd& n, const std::string& path) {
   double u = 1e-3;  // NRRD's space units are optional; Slicer and ITK mean millimetres
   for (unsigned a = 0; a < n.spaceDim; ++a) {
     if (!n.spaceUnits[a] || !*n.spaceUnits[a]) continue;
-    const std::string s = lower(n.spaceUnits[a]);
+    const std::string s = lower_case(n.spaceUnits[a]);
     if (s == "mm") u = 1e-3;
     else if (s == "m") u = 1.0;
     else if (s == "cm") u = 1e-2;

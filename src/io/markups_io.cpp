@@ -9,18 +9,10 @@
 #include <sstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 
 namespace btr {
 namespace {
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\n");
@@ -29,7 +21,7 @@ std::string trim(const std::string& s) {
 }
 
 double length_unit(const std::string& path, const std::string& units) {
-  const std::string u = lower(units);
+  const std::string u = lower_case(units);
   if (u.empty() || u == "mm") return 1e-3;
   if (u == "m") return 1.0;
   throw InputError(path + ": coordinate units '" + units + "' (expected mm or m)");
@@ -135,11 +127,11 @@ std::vector<NamedPoint> read_fcsv(const std::string& path, PatientFrame frame) {
     if (t[0] == '#') {
       const auto eq = t.find('=');
       if (eq == std::string::npos) continue;
-      const std::string key = lower(trim(t.substr(1, eq - 1))), value = trim(t.substr(eq + 1));
+      const std::string key = lower_case(trim(t.substr(1, eq - 1))), value = trim(t.substr(eq + 1));
       if (key == "coordinatesystem") file_frame = frame_of(path, value);
       if (key == "columns") {
         columns = split_csv(value);
-        for (auto& c : columns) c = lower(trim(c));
+        for (auto& c : columns) c = lower_case(trim(c));
       }
       continue;
     }
@@ -163,7 +155,7 @@ std::vector<NamedPoint> read_fcsv(const std::string& path, PatientFrame frame) {
 
 std::vector<NamedPoint> read_markups(const std::string& path, PatientFrame frame) {
   if (!std::filesystem::exists(path)) throw InputError(path + ": no such file");
-  const std::string p = lower(path);
+  const std::string p = lower_case(path);
   if (ends_with(p, ".json")) return read_json(path, frame);
   if (ends_with(p, ".fcsv")) return read_fcsv(path, frame);
   throw InputError(path + ": unknown markups format (expected .mrk.json or .fcsv)");

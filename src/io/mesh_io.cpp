@@ -13,14 +13,10 @@
 #include <vector>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 
 namespace btr {
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
-  return s;
-}
 
 std::ifstream open_in(const std::string& path, bool binary = false) {
   std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
@@ -207,7 +203,7 @@ void write_obj(const std::string& path, const SurfaceMesh& m, double inv) {
 // ---------------------------------------------------------------- OFF
 SurfaceMesh read_off(const std::string& path, double scale, bool require_faces) {
   TokenStream ts(path, true);
-  if (ts.done() || lower(ts.peek().text).find("off") == std::string::npos) throw InputError(path + ": missing OFF header");
+  if (ts.done() || lower_case(ts.peek().text).find("off") == std::string::npos) throw InputError(path + ": missing OFF header");
   ts.next("header");
   const long nv = ts.next_count("vertex count", 0);
   const long nf = ts.next_count("face count", 0);
@@ -298,7 +294,7 @@ SurfaceMesh read_stl(const std::string& path, double scale, bool require_faces) 
       std::istringstream ls(line);
       std::string tag;
       if (!(ls >> tag)) continue;
-      tag = lower(tag);
+      tag = lower_case(tag);
       if (tag == "vertex") {
         std::string a, b, c;
         if (!(ls >> a >> b >> c)) fail(path, ln, "vertex needs 3 coordinates");
@@ -475,7 +471,7 @@ void read_vtk_attributes(TokenStream& ts, const std::string& path, long count, s
     }
   };
   while (!ts.done()) {
-    const std::string kw = lower(ts.peek().text);
+    const std::string kw = lower_case(ts.peek().text);
     if (kw == "point_data" || kw == "cell_data") return;
     const auto tok = ts.next("attribute");
     if (kw == "scalars") {
@@ -484,7 +480,7 @@ void read_vtk_attributes(TokenStream& ts, const std::string& path, long count, s
       long comps = 1;
       if (!ts.done() && ts.peek().line == tok.line) comps = ts.next_long("scalars components");
       if (comps < 1 || comps > 4) fail(path, tok.line, "SCALARS '" + name + "' has " + std::to_string(comps) + " components (1 to 4)");
-      if (!ts.done() && lower(ts.peek().text) == "lookup_table") {
+      if (!ts.done() && lower_case(ts.peek().text) == "lookup_table") {
         ts.next("lookup_table");
         ts.next("lookup table name");
       }
@@ -543,11 +539,11 @@ TetMeshFile read_vtk(const std::string& path, double scale) {
   bool have_points = false, have_cells = false;
   while (!ts.done()) {
     const auto tok = ts.next("keyword");
-    const std::string kw = lower(tok.text);
+    const std::string kw = lower_case(tok.text);
     if (kw == "ascii") {
     } else if (kw == "dataset") {
       const auto t = ts.next("dataset type");
-      if (lower(t.text) != "unstructured_grid") fail(path, t.line, "dataset '" + t.text + "' is not UNSTRUCTURED_GRID");
+      if (lower_case(t.text) != "unstructured_grid") fail(path, t.line, "dataset '" + t.text + "' is not UNSTRUCTURED_GRID");
     } else if (kw == "binary") {
       fail(path, tok.line, "binary legacy VTK is not supported; save as ASCII");
     } else if (kw == "points") {
@@ -636,7 +632,7 @@ TetMeshFile read_medit(const std::string& path, double scale) {
   bool have_v = false;
   while (!ts.done()) {
     const auto tok = ts.next("keyword");
-    const std::string kw = lower(tok.text);
+    const std::string kw = lower_case(tok.text);
     if (kw == "meshversionformatted" || kw == "dimension") {
       const auto t = ts.next("value");
       if (kw == "dimension" && t.text != "3") fail(path, t.line, "only Dimension 3 is supported");
@@ -696,7 +692,7 @@ std::string file_extension(const std::string& path) {
   const size_t dot = path.find_last_of('.');
   const size_t slash = path.find_last_of('/');
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  return lower(path.substr(dot));
+  return lower_case(path.substr(dot));
 }
 
 SurfaceMesh read_surface(const std::string& path, LengthUnit unit) {
