@@ -5,17 +5,7 @@
 # override) and fails if the picture is blank. Installs rviz, xvfb and imagemagick when missing.
 set -euo pipefail
 REPO_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-bash "$REPO_ROOT/scripts/setup.sh"
-missing=()
-for p in rviz xvfb imagemagick libgl1-mesa-dri; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ "${#missing[@]}" -gt 0 ]; then
-  echo "[rviz] installing ${missing[*]}"
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+BTR_EXTRA_PACKAGES="rviz xvfb imagemagick libgl1-mesa-dri" bash "$REPO_ROOT/scripts/setup.sh"
 OUT="${BTR_OUT:-$REPO_ROOT/out/rviz}"
 BIN="$REPO_ROOT/build/ws/devel/lib/breast_tumour_registration"
 mkdir -p "$OUT"

@@ -21,6 +21,9 @@ DEB_PACKAGES=(
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for scripts/run_fuzz.sh (part of the tests)
 )
 
+# BTR_EXTRA_PACKAGES: further Debian packages a caller needs (scripts/render_rviz.sh: rviz, xvfb).
+read -r -a extra_packages <<< "${BTR_EXTRA_PACKAGES:-}"
+DEB_PACKAGES+=("${extra_packages[@]}")
 missing=()
 for p in "${DEB_PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

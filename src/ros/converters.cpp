@@ -133,13 +133,15 @@ SurfaceMesh from_mesh(const shape_msgs::Mesh& m) {
   return s;
 }
 
-visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& frame_id, const std::string& ns, int id,
-                                     float r, float g, float b, float a) {
+namespace {
+// A marker of `type` with the identity pose, unit scale and the colour given.
+visualization_msgs::Marker new_marker(int type, const std::string& frame_id, const std::string& ns, int id, float r, float g,
+                                      float b, float a) {
   visualization_msgs::Marker mk;
   mk.header.frame_id = frame_id;
   mk.ns = ns;
   mk.id = id;
-  mk.type = visualization_msgs::Marker::TRIANGLE_LIST;
+  mk.type = type;
   mk.action = visualization_msgs::Marker::ADD;
   mk.pose.orientation.w = 1.0;
   mk.scale.x = mk.scale.y = mk.scale.z = 1.0;
@@ -147,6 +149,13 @@ visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& fr
   mk.color.g = g;
   mk.color.b = b;
   mk.color.a = a;
+  return mk;
+}
+}  // namespace
+
+visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& frame_id, const std::string& ns, int id,
+                                     float r, float g, float b, float a) {
+  visualization_msgs::Marker mk = new_marker(visualization_msgs::Marker::TRIANGLE_LIST, frame_id, ns, id, r, g, b, a);
   mk.points.reserve(3 * s.F.rows());
   for (Eigen::Index f = 0; f < s.F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
@@ -163,12 +172,7 @@ visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& c
                                                const std::string& ns, int id, float r, float g, float b, float a) {
   const Ellipsoid95 e = ellipsoid_95(cov);
   const Eigen::Quaterniond q(e.axes);
-  visualization_msgs::Marker mk;
-  mk.header.frame_id = frame_id;
-  mk.ns = ns;
-  mk.id = id;
-  mk.type = visualization_msgs::Marker::SPHERE;
-  mk.action = visualization_msgs::Marker::ADD;
+  visualization_msgs::Marker mk = new_marker(visualization_msgs::Marker::SPHERE, frame_id, ns, id, r, g, b, a);
   mk.pose.position.x = centre.x();
   mk.pose.position.y = centre.y();
   mk.pose.position.z = centre.z();
@@ -179,10 +183,6 @@ visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& c
   mk.scale.x = 2 * e.semi_axes[0];
   mk.scale.y = 2 * e.semi_axes[1];
   mk.scale.z = 2 * e.semi_axes[2];
-  mk.color.r = r;
-  mk.color.g = g;
-  mk.color.b = b;
-  mk.color.a = a;
   return mk;
 }
 
