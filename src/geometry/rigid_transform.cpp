@@ -2,30 +2,34 @@
 
 #include <algorithm>
 
-#include <Eigen/SVD>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "breast_tumour_registration/base/errors.h"
 
 namespace btr {
 
+namespace {
+
+// Second-largest over largest variance of the centred rows: 0 for collinear points.
+double planarity(const Eigen::MatrixX3d& centred) {
+  const Vec3 ev = Eigen::SelfAdjointEigenSolver<Mat3>(centred.transpose() * centred, Eigen::EigenvaluesOnly).eigenvalues();
+  return ev[1] / std::max(ev[2], 1e-300);  // ascending order
+}
+
+}  // namespace
+
 Rigid kabsch(const Points& source, const Points& target) {
   if (source.rows() != target.rows()) throw InputError("kabsch: point sets differ in size");
   if (source.rows() < 3) throw InputError("rigid alignment from landmarks needs at least 3 pairs, got " + std::to_string(source.rows()));
   if (!source.allFinite() || !target.allFinite()) throw InputError("kabsch: NaN or infinite landmark coordinates");
-  const Vec3 cs = source.colwise().mean().transpose(), ct = target.colwise().mean().transpose();
-  const Eigen::MatrixX3d S = source.rowwise() - cs.transpose(), T = target.rowwise() - ct.transpose();
-  const Mat3 C = S.transpose() * T;
-  Eigen::JacobiSVD<Mat3> svd(C, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Vec3 sv = svd.singularValues();
-  if (sv[1] <= 1e-12 * std::max(sv[0], 1e-300))
+  const Eigen::MatrixX3d S = source.rowwise() - source.colwise().mean(), T = target.rowwise() - target.colwise().mean();
+  if (planarity(S) <= 1e-12 || planarity(T) <= 1e-12)
     throw InputError("rigid alignment from landmarks: the landmarks are collinear (rotation undetermined)");
-  Mat3 D = Mat3::Identity();
-  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
-  const Mat3 R = svd.matrixV() * D * svd.matrixU().transpose();
+  // Umeyama (1991) without scaling, reflection excluded: Eigen's implementation.
   Rigid out = Rigid::Identity();
-  out.linear() = R;
-  out.translation() = ct - R * cs;
+  out.matrix() = Eigen::umeyama(source.transpose(), target.transpose(), false);
   return out;
 }
 
