@@ -8,19 +8,16 @@
 #include <cmath>
 #include <string>
 
+#include "breast_tumour_registration/base/strings.h"
+
 namespace btr::cli {
 
 inline CLI::Validator finite_at_least(double lo, bool inclusive, const std::string& what) {
   return CLI::Validator(
       [=](std::string& s) -> std::string {
-        double v = 0;
-        try {
-          size_t used = 0;
-          v = std::stod(s, &used);
-          if (used != s.size()) return "'" + s + "' is not a number";
-        } catch (const std::exception&) {
-          return "'" + s + "' is not a number";
-        }
+        const auto parsed = parse_number(s);
+        if (!parsed) return "'" + s + "' is not a number";
+        const double v = *parsed;
         if (!std::isfinite(v)) return "'" + s + "' is not finite";
         if (inclusive ? v < lo : v <= lo) return "'" + s + "' must be " + what;
         return std::string();

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 
 namespace btr {
 namespace {
@@ -25,23 +26,15 @@ std::vector<std::string> split_fields(std::string line) {
 // An index: a whole number that fits an int (indices of 2^31 and above used to wrap to valid
 // vertices through a narrowing cast).
 bool parse_int(const std::string& s, long& v) {
-  try {
-    size_t used = 0;
-    v = std::stol(s, &used);
-    return used == s.size() && v <= std::numeric_limits<int>::max() && v >= std::numeric_limits<int>::min();
-  } catch (const std::logic_error&) {
-    return false;
-  }
+  const auto x = parse_integer(s);
+  if (x) v = *x;
+  return x.has_value();
 }
 
 bool parse_real(const std::string& s, double& v) {
-  try {
-    size_t used = 0;
-    v = std::stod(s, &used);
-    return used == s.size();
-  } catch (const std::logic_error&) {
-    return false;
-  }
+  const auto x = parse_number(s);
+  if (x) v = *x;
+  return x.has_value();
 }
 
 }  // namespace

@@ -26,14 +26,9 @@ const std::vector<std::string> kTableKeys = {"fat",     "gland",        "tumour"
 // A label value, or a segment name of the volume.
 int label_value(const YamlFields& c, const YAML::Node& n, const std::string& field, const LabelVolume& v) {
   const std::string s = c.text(n, field);
-  try {
-    size_t used = 0;
-    const int l = std::stoi(s, &used);
-    if (used == s.size()) {
-      if (l < 1 || l > 255) c.fail(field, "label " + s + " is outside 1 to 255");
-      return l;
-    }
-  } catch (const std::logic_error&) {
+  if (const auto l = parse_integer(s)) {
+    if (*l < 1 || *l > 255) c.fail(field, "label " + s + " is outside 1 to 255");
+    return *l;
   }
   for (const auto& [l, name] : v.names)
     if (lower_case(name) == lower_case(s)) return l;

@@ -1,6 +1,6 @@
 #include "breast_tumour_registration/io/markups_io.h"
 
-#include <charconv>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -106,11 +106,9 @@ std::vector<std::string> split_csv(const std::string& line) {
 
 double number(const std::string& path, int line, const std::string& field) {
   const std::string s = trim(field);
-  double x = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), x);
-  if (r.ec != std::errc() || r.ptr != s.data() + s.size())
-    throw InputError(path + ":" + std::to_string(line) + ": '" + s + "' is not a number");
-  return x;
+  const auto x = parse_number(s);
+  if (!x) throw InputError(path + ":" + std::to_string(line) + ": '" + s + "' is not a number");
+  return *x;
 }
 
 std::vector<NamedPoint> read_fcsv(const std::string& path, PatientFrame frame) {

@@ -36,29 +36,16 @@ std::ofstream open_out(const std::string& path, bool binary = false) {
 }
 
 double parse_double(const std::string& tok, const std::string& path, size_t line) {
-  try {
-    size_t used = 0;
-    double v = std::stod(tok, &used);
-    if (used != tok.size()) fail(path, line, "cannot parse number '" + tok + "'");
-    return v;
-  } catch (const std::logic_error&) {
-    // stod throws out_of_range for denormals on some libcs; treat as a parse error.
-    fail(path, line, "cannot parse number '" + tok + "'");
-  }
+  const auto v = parse_number(tok);
+  if (!v) fail(path, line, "cannot parse number '" + tok + "'");
+  return *v;
 }
 
 long parse_long(const std::string& tok, const std::string& path, size_t line) {
-  try {
-    size_t used = 0;
-    long v = std::stol(tok, &used);
-    if (used != tok.size()) fail(path, line, "cannot parse integer '" + tok + "'");
-    // Counts and indices are ints inside: a larger value must not wrap to a valid one.
-    if (v > std::numeric_limits<int>::max() || v < std::numeric_limits<int>::min())
-      fail(path, line, "integer '" + tok + "' is out of range (at most 2^31 - 1)");
-    return v;
-  } catch (const std::logic_error&) {
-    fail(path, line, "cannot parse integer '" + tok + "'");
-  }
+  if (const auto v = parse_integer(tok)) return *v;
+  // Counts and indices are ints inside: a larger value must not wrap to a valid one.
+  const bool digits = !tok.empty() && tok.find_first_not_of("+-0123456789") == std::string::npos;
+  fail(path, line, digits ? "integer '" + tok + "' is out of range (at most 2^31 - 1)" : "cannot parse integer '" + tok + "'");
 }
 
 // The whitespace-separated tokens of a text file with their line numbers, for the formats

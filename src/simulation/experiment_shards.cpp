@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 #include "breast_tumour_registration/simulation/experiment_suite.h"
 
 namespace btr {
@@ -24,13 +25,13 @@ ShardRange shard_range(size_t items, int k, int n) {
 }
 
 void parse_shard(const std::string& text, int& k, int& n) {
-  int kk = 0, nn = 0;
-  char slash = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &kk, &slash, &nn, &extra) != 3 || slash != '/')
-    throw InputError("--shard '" + text + "': expected K/N, e.g. 3/8");
-  shard_range(0, kk, nn);  // checks the bounds
-  k = kk;
-  n = nn;
+  const size_t slash = text.find('/');
+  const auto kk = slash == std::string::npos ? std::nullopt : parse_integer(std::string_view(text).substr(0, slash));
+  const auto nn = slash == std::string::npos ? std::nullopt : parse_integer(std::string_view(text).substr(slash + 1));
+  if (!kk || !nn) throw InputError("--shard '" + text + "': expected K/N, e.g. 3/8");
+  shard_range(0, *kk, *nn);  // checks the bounds
+  k = *kk;
+  n = *nn;
 }
 
 std::string plan_fingerprint(const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,

@@ -1,7 +1,9 @@
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 #include "breast_tumour_registration/geometry/box_mesh.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/io/index_io.h"
@@ -242,4 +244,18 @@ TEST(MeshIoErrors, CellDataThatDoesNotFitTheCellsIsRefused) {
   expect_throw_with<InputError>([&] { cell_labels(f, "", dir + "/none.vtk"); }, "no cell labels");
   expect_throw_with<InputError>([&] { write_tet_mesh(dir + "/bad.vtk", f.mesh, LengthUnit::Millimetre, {1, 2}); },
                                 "2 cell labels for 1 tetrahedra");
+}
+
+// The one number parser every reader uses (std::from_chars, no locale, no wrap-around).
+TEST(NumberParsing, WholeTokenOrNothing) {
+  EXPECT_EQ(parse_number("1.5e-3").value(), 1.5e-3);
+  EXPECT_EQ(parse_number("+2").value(), 2.0);
+  EXPECT_EQ(parse_number("-0.25").value(), -0.25);
+  EXPECT_TRUE(std::isinf(parse_number("inf").value()));
+  for (const char* bad : {"", "+", "1.5mm", " 1", "1 ", "--1", "+-1", "1e999", "zero", "0x10"})
+    EXPECT_FALSE(parse_number(bad).has_value()) << bad;
+  EXPECT_EQ(parse_integer("2147483647").value(), 2147483647);
+  EXPECT_EQ(parse_integer("-7").value(), -7);
+  EXPECT_EQ(parse_integer("+7").value(), 7);
+  for (const char* bad : {"2147483648", "1.0", "7a", "", "4294967296"}) EXPECT_FALSE(parse_integer(bad).has_value()) << bad;
 }
