@@ -6,6 +6,8 @@
 #include <random>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/skinning_subspace.h"
 #include "breast_tumour_registration/geometry/shapes.h"
@@ -470,9 +472,29 @@ TEST(Outputs, ReportAndPictureAreWritten) {
   char sig[8];
   png.read(sig, 8);
   EXPECT_EQ(std::string(sig + 1, 3), "PNG");
-  const std::string json = registration_report_json(s, m, r, 0.1);
-  EXPECT_NE(json.find("\"centroid_distance_mm\""), std::string::npos);
-  EXPECT_NE(json.find("\"rigid_transform_supine_to_model\""), std::string::npos);
+  // The report is JSON a reader parses, and its numbers are the result's, in its units.
+  std::ifstream report(d + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(report);
+  EXPECT_EQ(j.at("converged").get<bool>(), r.converged);
+  EXPECT_EQ(j.at("steps").get<std::string>(), r.steps.describe());
+  EXPECT_EQ(j.at("mesh").at("tetrahedra").get<long>(), m.rest.T.rows());
+  ASSERT_EQ(j.at("tumours").size(), r.tumours.size());
+  for (size_t i = 0; i < r.tumours.size(); ++i) {
+    const auto& t = j.at("tumours")[i];
+    EXPECT_EQ(t.at("name").get<std::string>(), r.tumours[i].name);
+    EXPECT_DOUBLE_EQ(t.at("centroid_distance_mm").get<double>(), r.tumours[i].centroid_distance * 1e3);
+    for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(t.at("centroid_supine_mm")[k].get<double>(), r.tumours[i].centroid[k] * 1e3);
+  }
+  ASSERT_EQ(j.at("step_reports").size(), r.reports.size());
+  for (size_t i = 0; i < r.reports.size(); ++i) {
+    EXPECT_EQ(j.at("step_reports")[i].at("step").get<std::string>(), r.reports[i].name);
+    EXPECT_EQ(j.at("step_reports")[i].at("newton_iterations").get<int>(), r.reports[i].iterations);
+    EXPECT_EQ(j.at("step_reports")[i].at("stop").get<std::string>(), r.reports[i].stop_reason);
+  }
+  const auto& rot = j.at("rigid_transform_supine_to_model").at("rotation");
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) EXPECT_DOUBLE_EQ(rot[a][b].get<double>(), r.supine_to_model.linear()(a, b));
+  EXPECT_EQ(j.at("warnings").get<std::vector<std::string>>(), r.warnings);
   const TetMesh back = read_tet_mesh(d + "/registered.vtk", LengthUnit::Millimetre);
   EXPECT_EQ(back.T.rows(), m.rest.T.rows());
 }
