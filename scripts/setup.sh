@@ -17,7 +17,8 @@ DEB_PACKAGES=(
   libtf2-msgs-dev
   libnifti2-dev libteem-dev nlohmann-json3-dev  # label maps (NIfTI, NRRD) and Slicer markups (issue 15)
   libopenblas0-pthread libyaml-cpp-dev libcli11-dev libgtest-dev libbenchmark-dev
-  python3-matplotlib python3-numpy zlib1g-dev cmake g++ make time
+  libcairo2-dev fonts-dejavu-core  # the cross-section picture (axes, legend)
+  python3-matplotlib python3-numpy pkg-config cmake g++ make time
   clang libclang-rt-14-dev  # libFuzzer + sanitizers for scripts/run_fuzz.sh (part of the tests)
 )
 
