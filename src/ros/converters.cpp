@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/ros/converters.h"
 
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include <Eigen/Geometry>
 
@@ -186,24 +187,19 @@ visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& c
   return mk;
 }
 
-geometry_msgs::Transform to_transform(const Rigid& T) {
-  geometry_msgs::Transform t;
-  t.translation.x = T.translation().x();
-  t.translation.y = T.translation().y();
-  t.translation.z = T.translation().z();
-  const Eigen::Quaterniond q(T.rotation());
-  t.rotation.x = q.x();
-  t.rotation.y = q.y();
-  t.rotation.z = q.z();
-  t.rotation.w = q.w();
-  return t;
-}
+geometry_msgs::Transform to_transform(const Rigid& T) { return tf2::eigenToTransform(T).transform; }
 
 Rigid from_transform(const geometry_msgs::Transform& t) {
-  Rigid T = Rigid::Identity();
-  T.linear() = Eigen::Quaterniond(t.rotation.w, t.rotation.x, t.rotation.y, t.rotation.z).normalized().toRotationMatrix();
-  T.translation() = Vec3(t.translation.x, t.translation.y, t.translation.z);
-  return T;
+  // tf2_eigen takes the quaternion as it is; a publisher's may be off unit length by rounding.
+  const double n = std::sqrt(t.rotation.w * t.rotation.w + t.rotation.x * t.rotation.x + t.rotation.y * t.rotation.y +
+                             t.rotation.z * t.rotation.z);
+  if (!std::isfinite(n) || n < 1e-9) throw InputError("transform has a zero or non-finite rotation quaternion");
+  geometry_msgs::Transform u = t;
+  u.rotation.w /= n;
+  u.rotation.x /= n;
+  u.rotation.y /= n;
+  u.rotation.z /= n;
+  return tf2::transformToEigen(u);
 }
 
 }  // namespace btr::ros_conv

@@ -144,6 +144,13 @@ TEST(Converters, MeshMarkerAndTransformRoundTrips) {
   T.linear() = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
   T.translation() = Vec3(0.1, -0.2, 0.75);
   EXPECT_LT((ros_conv::from_transform(ros_conv::to_transform(T)).matrix() - T.matrix()).norm(), 1e-12);
+  // A quaternion off unit length (rounding in a publisher) still gives a rotation; a zero one is refused.
+  geometry_msgs::Transform scaled = ros_conv::to_transform(T);
+  scaled.rotation.x *= 1.001, scaled.rotation.y *= 1.001, scaled.rotation.z *= 1.001, scaled.rotation.w *= 1.001;
+  EXPECT_LT((ros_conv::from_transform(scaled).matrix() - T.matrix()).norm(), 1e-12);
+  geometry_msgs::Transform zero;
+  zero.rotation.w = 0;
+  EXPECT_THROW(ros_conv::from_transform(zero), InputError);
   shape_msgs::Mesh bad = m;
   bad.triangles[0].vertex_indices[1] = 100000;
   EXPECT_THROW(ros_conv::from_mesh(bad), InputError);

@@ -22,7 +22,9 @@ struct CloudPoints {
   long finite = 0;      ///< number of finite points
 };
 
-/// Reads x, y, z (FLOAT32 or FLOAT64) of a PointCloud2. `keep_nan` keeps the organized
+/// Reads x, y, z (FLOAT32 or FLOAT64) of a PointCloud2. Not pcl::fromROSMsg: that reads past
+/// the end of a cloud whose data is shorter than its layout and turns FLOAT64 fields into
+/// zeros (measured, bench/probes/pcl_from_ros_msg.cpp); every cloud here comes from outside. `keep_nan` keeps the organized
 /// layout (NaN rows); otherwise NaN and infinite points are dropped. Throws InputError for
 /// a cloud without x, y, z fields or with inconsistent sizes.
 CloudPoints from_cloud(const sensor_msgs::PointCloud2& msg, bool keep_nan);
@@ -43,6 +45,8 @@ visualization_msgs::Marker to_marker(const SurfaceMesh& s, const std::string& fr
 visualization_msgs::Marker to_ellipsoid_marker(const Vec3& centre, const Mat3& cov, const std::string& frame_id,
                                                const std::string& ns, int id, float r, float g, float b, float a);
 
+/// Through tf2_eigen; from_transform normalizes the quaternion and throws InputError for a
+/// zero or non-finite one.
 geometry_msgs::Transform to_transform(const Rigid& T);
 Rigid from_transform(const geometry_msgs::Transform& t);
 
