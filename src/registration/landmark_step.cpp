@@ -8,7 +8,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
-#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/rigid_free_landmark_energy.h"
 #include "breast_tumour_registration/fem/subspace_solver.h"
 
@@ -26,11 +26,11 @@ StepReport landmark_step(const RegistrationModel& model, const std::vector<Ancho
   add_model_elastic_energy(energy, model);
   auto gravity = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
   if (opt.gravity) energy.add(gravity);
-  auto springs = std::make_shared<PointConstraintEnergy>(opt.weight);
+  auto springs = std::make_shared<SpringEnergy>("landmarks");
   std::vector<int> seeds;
   std::vector<std::vector<int>> cliques;
   for (size_t i = 0; i < anchors.size(); ++i) {
-    if (!pose) springs->add(anchors[i], targets.row(i).transpose());
+    if (!pose) springs->add_point(anchors[i], targets.row(i).transpose(), opt.weight);
     // Seed the sampling with the anchor's dominant vertex (thesis: landmarks first).
     int best = 0;
     for (int k = 1; k < anchors[i].count; ++k)

@@ -11,8 +11,7 @@
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/fixed_point_estimate.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
-#include "breast_tumour_registration/fem/plane_constraint_energy.h"
-#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/rigid_free_surface_energy.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 
@@ -37,15 +36,13 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   add_model_elastic_energy(energy, model);
   auto gravity = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
   if (opt.gravity) energy.add(gravity);
-  auto points = std::make_shared<PointConstraintEnergy>(opt.point_weight);
-  auto planes = std::make_shared<PlaneConstraintEnergy>(opt.plane_weight);
+  auto springs = std::make_shared<SpringEnergy>("skin to supine surface");
   auto free_springs = std::make_shared<RigidFreeSurfaceEnergy>(opt.point_weight, opt.plane_weight);
   if (pose) {
     if (pose_points) free_springs->set_points(pose_points->anchors, pose_points->targets, opt.pose_points_weight);
     energy.add(free_springs);
   } else {
-    energy.add(points);
-    energy.add(planes);
+    energy.add(springs);
   }
   StepSolvers local;  // without an engine's cache: built for this call only
   NewtonSolver& solver = (cache ? *cache : local).newton(pose ? "surface (pose free)" : "surface", model, energy.hessian_cliques());
@@ -65,8 +62,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   // best fits xs to the previous correspondences). Returns how many skin vertices they hold.
   auto project_at = [&](const Points& xs, bool update_pose) {
     const auto tp = std::chrono::steady_clock::now();
-    points->clear();
-    planes->clear();
+    springs->clear();
     held.clear();
     std::vector<int> verts;
     if (pose && update_pose && free_springs->size() >= 3) P = free_springs->pose(xs);  // fewer: keep the last pose
@@ -80,8 +76,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
         held_n.row(k) = c.normal.transpose();
         verts.push_back(v);
       } else {
-        points->add(Anchor::vertex(v), c.point);
-        planes->add(Anchor::vertex(v), c.point, c.normal);
+        springs->add_point_and_plane(Anchor::vertex(v), c.point, c.normal, opt.point_weight, opt.plane_weight);
       }
       held.push_back(static_cast<int>(i));
     }

@@ -10,8 +10,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
-#include "breast_tumour_registration/fem/plane_constraint_energy.h"
-#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
@@ -107,17 +106,16 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   add_model_elastic_energy(elastic, model);
   // A held target moving by delta along n moves both springs' targets: dG/d delta = -spring n.
   const double spring = surface.point_weight + surface.plane_weight;
-  auto planes = std::make_shared<PlaneConstraintEnergy>(opt.held_projections ? surface.plane_weight : spring);
-  auto points = std::make_shared<PointConstraintEnergy>(surface.point_weight);
-  for (const HeldSkinVertex& h : held) {
-    planes->add(Anchor::vertex(h.vertex), h.point, h.normal);
-    points->add(Anchor::vertex(h.vertex), h.point);
-  }
+  // Held projections: the springs as the surface step has them; else a projection that follows
+  // the vertex along the surface leaves only the normal direction, with both springs' weight.
+  auto springs = std::make_shared<SpringEnergy>("held skin");
+  for (const HeldSkinVertex& h : held)
+    springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, opt.held_projections ? surface.point_weight : 0,
+                                 opt.held_projections ? surface.plane_weight : spring);
   if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
   TotalEnergy jac;
   for (const auto& t : elastic.terms()) jac.add(t);
-  jac.add(planes);
-  if (opt.held_projections) jac.add(points);
+  jac.add(springs);
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   llt.cholmod().print = 0;

@@ -7,8 +7,7 @@
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/fem/nodal_volume_energy.h"
-#include "breast_tumour_registration/fem/plane_constraint_energy.h"
-#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/rigid_free_landmark_energy.h"
 #include "breast_tumour_registration/fem/rigid_free_surface_energy.h"
 #include "breast_tumour_registration/fem/total_energy.h"
@@ -153,27 +152,38 @@ TEST(GravityEnergy, GradientMatchesFiniteDifferencesAndMassIsConserved) {
   check_term(e, m, perturbed(m, 0.004, 4));
 }
 
-TEST(PointConstraintEnergy, VertexTriangleAndTetAnchors) {
+// One spring term, every metric: point (w I), plane (w n n^T), both, and a general SPD matrix,
+// on vertex, triangle and tetrahedron anchors.
+TEST(SpringEnergy, PointPlaneAndGeneralMetricsOnVertexTriangleAndTetAnchors) {
   const TetMesh m = small_mesh();
-  PointConstraintEnergy e(1e4);
-  e.add(Anchor::vertex(5), Vec3(0.01, 0.02, 0.03));
-  e.add(triangle_anchor(m.T(4, 0), m.T(4, 1), m.T(4, 2)), Vec3(-0.01, 0.0, 0.05));
+  SpringEnergy e;
+  e.add_point(Anchor::vertex(5), Vec3(0.01, 0.02, 0.03), 1e4);
+  e.add_point(triangle_anchor(m.T(4, 0), m.T(4, 1), m.T(4, 2)), Vec3(-0.01, 0.0, 0.05), 1e4);
   Anchor tet;
   tet.count = 4;
   for (int k = 0; k < 4; ++k) {
     tet.v[k] = m.T(9, k);
     tet.w[k] = 0.1 + 0.1 * k;
   }
-  e.add(tet, Vec3(0.02, 0.02, 0.02));
+  e.add_point(tet, Vec3(0.02, 0.02, 0.02), 1e4);
+  e.add_plane(Anchor::vertex(3), Vec3(0.01, 0.02, 0.03), Vec3(1, 2, 2), 1e4);
+  e.add_plane(triangle_anchor(m.T(2, 0), m.T(2, 1), m.T(2, 3)), Vec3(0.0, 0.01, 0.0), Vec3(0, 0, 3), 1e4);
+  e.add_point_and_plane(Anchor::vertex(7), Vec3(0.0, 0.01, 0.02), Vec3(0, 1, 1), 3e3, 2e4);
+  Mat3 A;
+  A << 2, 0.5, 0, 0.5, 1, 0.3, 0, 0.3, 3;
+  e.add(Anchor::vertex(11), Vec3(0.03, 0.0, 0.01), 1e4 * A);
   check_term(e, m, perturbed(m, 0.004, 5));
 }
 
-TEST(PlaneConstraintEnergy, VertexAndTriangleAnchors) {
+// The point-to-plane metric is the thesis's eq. 4.3: w/2 ((p - q) . n)^2, sliding in the plane free.
+TEST(SpringEnergy, ThePlaneMetricIsTheSquaredDistanceToThePlane) {
   const TetMesh m = small_mesh();
-  PlaneConstraintEnergy e(1e4);
-  e.add(Anchor::vertex(3), Vec3(0.01, 0.02, 0.03), Vec3(1, 2, 2));
-  e.add(triangle_anchor(m.T(2, 0), m.T(2, 1), m.T(2, 3)), Vec3(0.0, 0.01, 0.0), Vec3(0, 0, 3));
-  check_term(e, m, perturbed(m, 0.004, 6));
+  SpringEnergy e;
+  const Vec3 q(0.01, 0.02, 0.03), n = Vec3(1, 2, 2) / 3.0;
+  e.add_plane(Anchor::vertex(3), q, 3 * n, 5e3);
+  Points x = m.V;
+  x.row(3) = (q + 0.002 * n + 0.01 * Vec3(2, -1, 0).normalized()).transpose();  // 2 mm off the plane, slid along it
+  EXPECT_NEAR(e.value(x), 0.5 * 5e3 * 0.002 * 0.002, 1e-15);
 }
 
 // The pose-free landmark term: exact derivatives (pose eliminated), with data that is a
@@ -321,10 +331,17 @@ TEST(RigidFreeSurfaceEnergy, NewtonWithTheLowRankPartRecoversARigidlyMovedScan) 
 }
 
 TEST(Constraints, BadWeightsAndNormalsAreRejected) {
-  btr::test::expect_throw_with<InputError>([] { PointConstraintEnergy(-1); }, "weight must be finite and >= 0");
-  btr::test::expect_throw_with<InputError>([] { PlaneConstraintEnergy(std::nan("")); }, "weight must be finite");
-  PlaneConstraintEnergy p(1);
-  btr::test::expect_throw_with<InputError>([&] { p.add(Anchor::vertex(0), Vec3::Zero(), Vec3::Zero()); }, "non-zero normal");
+  SpringEnergy p;
+  btr::test::expect_throw_with<InputError>([&] { p.add_point(Anchor::vertex(0), Vec3::Zero(), -1); }, "weight must be finite and >= 0");
+  btr::test::expect_throw_with<InputError>([&] { p.add_plane(Anchor::vertex(0), Vec3::Zero(), Vec3::UnitZ(), std::nan("")); },
+                                           "weight must be finite");
+  btr::test::expect_throw_with<InputError>([&] { p.add_plane(Anchor::vertex(0), Vec3::Zero(), Vec3::Zero(), 1); }, "non-zero");
+  btr::test::expect_throw_with<InputError>([&] { p.add(Anchor::vertex(0), Vec3::Zero(), -Mat3::Identity()); }, "semi-definite");
+  Mat3 skew = Mat3::Identity();
+  skew(0, 1) = 1;
+  btr::test::expect_throw_with<InputError>([&] { p.add(Anchor::vertex(0), Vec3::Zero(), skew); }, "symmetric");
+  btr::test::expect_throw_with<InputError>([&] { p.add_point(Anchor::vertex(0), Vec3(0, std::nan(""), 0), 1); }, "not finite");
+  EXPECT_EQ(p.size(), 0u);
 }
 
 TEST(TotalEnergy, SumOfTermsWithFixedVerticesEliminated) {

@@ -5,7 +5,7 @@
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
-#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/box_mesh.h"
 #include "test_util.h"
@@ -90,12 +90,12 @@ TEST_P(PenaltyExtremes, LandmarkPullFromOneToHundredMillionNewtonPerMetre) {
   TotalEnergy energy;
   energy.add(std::make_shared<ElasticEnergy>(s.mesh, std::vector<StableNeoHookean>{StableNeoHookean(3400, 0.49)}));
   energy.add(std::make_shared<GravityEnergy>(s.mesh, 1000, Vec3(0, 0, -9.81)));
-  auto pts = std::make_shared<PointConstraintEnergy>(w);
+  auto pts = std::make_shared<SpringEnergy>();
   // Pull three top vertices 15 mm sideways and down.
   std::vector<int> top;
   for (Eigen::Index i = 0; i < s.mesh.V.rows(); ++i)
     if (s.mesh.V(i, 2) == 0.06 && s.mesh.V(i, 1) == 0.04) top.push_back(static_cast<int>(i));
-  for (int v : top) pts->add(Anchor::vertex(v), s.mesh.V.row(v).transpose() + Vec3(0.015, 0, -0.01));
+  for (int v : top) pts->add_point(Anchor::vertex(v), s.mesh.V.row(v).transpose() + Vec3(0.015, 0, -0.01), w);
   energy.add(pts);
   NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(s.mesh.V.rows()), s.mesh.T, s.fixed), s.mesh.T);
   Points x = s.mesh.V;

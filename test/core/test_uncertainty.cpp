@@ -4,8 +4,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
-#include "breast_tumour_registration/fem/plane_constraint_energy.h"
-#include "breast_tumour_registration/fem/point_constraint_energy.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
@@ -112,14 +111,10 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     TotalEnergy energy;
     add_model_elastic_energy(energy, m);
     energy.add(std::make_shared<GravityEnergy>(m.rest, m.material.density, gravity));
-    auto points = std::make_shared<PointConstraintEnergy>(o.surface.point_weight);
-    auto planes = std::make_shared<PlaneConstraintEnergy>(o.surface.plane_weight);
-    for (const HeldSkinVertex& k : held) {
-      points->add(Anchor::vertex(k.vertex), k.point);
-      planes->add(Anchor::vertex(k.vertex), k.point, k.normal);
-    }
-    energy.add(points);
-    energy.add(planes);
+    auto springs = std::make_shared<SpringEnergy>();
+    for (const HeldSkinVertex& k : held)
+      springs->add_point_and_plane(Anchor::vertex(k.vertex), k.point, k.normal, o.surface.point_weight, o.surface.plane_weight);
+    energy.add(springs);
     NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.rest.V.rows()), m.rest.T, m.fixed,
                                                            energy.hessian_cliques()),
                         m.rest.T);
