@@ -16,23 +16,29 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-}  // namespace
+// The state at which a stall let the line search invert elements (recover_from_stall). A solve
+// that then ends with more than max_inverted_fraction_after_stall of its tetrahedra newly
+// inverted folded the mesh to meet its constraints (landmarks pulled through the chest
+// wall): the state is restored and the solve reported as InvertedAfterStall. One that ends
+// within it keeps its result, and the count is reported (soft tissue whose prone shape
+// stands in for the rest shape: 1 to 6 of 7.1k elements at E = 400 Pa).
+struct InversionGuard {
+  bool armed = false;
+  Points x;
+  double energy = 0;
+  long inverted = 0;
+  // Records the state the first time res.inversions_allowed is set.
+  void arm(const NewtonResult& res, const Points& x_now, double E, long n_inv);
+  // At the end of a solve: restores the recorded state when x has more than
+  // max_fraction x n_tets inversions beyond it; returns true when it did.
+  bool restore_if_worse(Points& x_now, double& E, long& n_inv, NewtonResult& res, long n_tets, double max_fraction) const;
+};
 
-std::string to_string(StopReason r) {
-  switch (r) {
-    case StopReason::GradientTolerance: return "gradient tolerance reached";
-    case StopReason::StepTolerance: return "full Newton step below the step tolerance";
-    case StopReason::Stalled: return "stalled: line-search steps below the step tolerance with the gradient above its tolerance";
-    case StopReason::InvertedAfterStall:
-      return "stalled: every step inverted an element, and letting them invert folded the mesh; the last uninverted "
-             "state is kept";
-    case StopReason::MaxIterations: return "maximum iterations reached";
-    case StopReason::LineSearchFailed: return "line search found no decrease";
-    case StopReason::Aborted: return "aborted by callback";
-  }
-  return "unknown";
-}
+LineSearchOptions line_search_options(const NewtonOptions& opt);
 
+// Takes the step dx (#V by 3) with the line search from x (energy E, n_inv inverted
+// tetrahedra), updating x, E, n_inv, the iteration's alpha / step norm / line-search time and
+// the result's time totals.
 StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
                               const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
                               long& n_inv, IterationInfo& info, NewtonResult& res) {
@@ -56,6 +62,8 @@ StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets,
   return StepOutcome::Taken;
 }
 
+// Records an accepted iteration in `res` (history, totals), calls the callback and applies
+// the gradient criterion; returns true when the solve should stop (reason and converged set).
 bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res) {
   res.iterations = info.iteration;
   res.energy = info.energy;
@@ -70,33 +78,6 @@ bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, doubl
     res.reason = StopReason::GradientTolerance;
     res.converged = true;
     return true;
-  }
-  return false;
-}
-
-bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res) {
-  if (direction_was_lagged) return true;  // first: a fresh factorization
-  if (outcome != StepOutcome::TooSmall && opt.forbid_new_inversions) {
-    // Second: let the line search invert elements. The stable Neo-Hookean energy is defined
-    // there, and soft tissue pulled by stiff springs otherwise freezes on one nearly flat
-    // element (measured: E = 400 Pa, surface step stalled at 590 N, tumour 13.8 mm off;
-    // with inversions allowed it converges, 0.77 mm). The result reports the inverted count.
-    opt.forbid_new_inversions = false;
-    res.inversions_allowed = true;
-    return true;
-  }
-  switch (outcome) {
-    case StepOutcome::TooSmall:  // the exact Newton step: the minimum is within step_tolerance
-      res.reason = StopReason::StepTolerance;
-      res.converged = true;
-      break;
-    case StepOutcome::NoDecrease:
-      res.reason = StopReason::LineSearchFailed;
-      res.converged = false;
-      break;
-    default:  // a damped step too short to make progress
-      res.reason = StopReason::Stalled;
-      res.converged = false;
   }
   return false;
 }
@@ -128,33 +109,59 @@ LineSearchOptions line_search_options(const NewtonOptions& opt) {
   return l;
 }
 
-struct NewtonSolver::Impl {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  bool analyzed = false;
-  bool have_factor = false;  // llt holds a factor of some earlier Hessian (same pattern)
+}  // namespace
 
-};
-
-NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
-    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {
-  // A failed factorization is expected (the unprojected Hessian tried near the solution) and
-  // handled here; CHOLMOD's own "not positive definite" lines on stderr would only alarm.
-  impl_->llt.cholmod().print = 0;
+std::string to_string(StopReason r) {
+  switch (r) {
+    case StopReason::GradientTolerance: return "gradient tolerance reached";
+    case StopReason::StepTolerance: return "full Newton step below the step tolerance";
+    case StopReason::Stalled: return "stalled: line-search steps below the step tolerance with the gradient above its tolerance";
+    case StopReason::InvertedAfterStall:
+      return "stalled: every step inverted an element, and letting them invert folded the mesh; the last uninverted "
+             "state is kept";
+    case StopReason::MaxIterations: return "maximum iterations reached";
+    case StopReason::LineSearchFailed: return "line search found no decrease";
+    case StopReason::Aborted: return "aborted by callback";
+  }
+  return "unknown";
 }
 
-NewtonSolver::~NewtonSolver() = default;
+bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res) {
+  if (direction_was_lagged) return true;  // first: a fresh factorization
+  if (outcome != StepOutcome::TooSmall && opt.forbid_new_inversions) {
+    // Second: let the line search invert elements. The stable Neo-Hookean energy is defined
+    // there, and soft tissue pulled by stiff springs otherwise freezes on one nearly flat
+    // element (measured: E = 400 Pa, surface step stalled at 590 N, tumour 13.8 mm off;
+    // with inversions allowed it converges, 0.77 mm). The result reports the inverted count.
+    opt.forbid_new_inversions = false;
+    res.inversions_allowed = true;
+    return true;
+  }
+  switch (outcome) {
+    case StepOutcome::TooSmall:  // the exact Newton step: the minimum is within step_tolerance
+      res.reason = StopReason::StepTolerance;
+      res.converged = true;
+      break;
+    case StepOutcome::NoDecrease:
+      res.reason = StopReason::LineSearchFailed;
+      res.converged = false;
+      break;
+    default:  // a damped step too short to make progress
+      res.reason = StopReason::Stalled;
+      res.converged = false;
+  }
+  return false;
+}
 
-void NewtonSolver::forget_factor() { impl_->have_factor = false; }
-
-NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
+NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, const Tetrahedra& tets,
+                             NewtonLinearSolve& linear, Points& x, const NewtonOptions& opt) {
   const auto t_start = Clock::now();
-  HessianAssembler& H = *assembler_;
   NewtonResult res;
-  auto inverted = [&](const Points& p) { return tets_.rows() ? count_inverted(p, tets_) : 0L; };
+  auto inverted = [&](const Points& p) { return tets.rows() ? count_inverted(p, tets) : 0L; };
 
   double E = energy.value(x);
   if (!std::isfinite(E)) throw SolverError("energy is not finite at the initial state (NaN or Inf positions?)");
-  Eigen::VectorXd g = H.gather(energy.gradient(x));
+  Eigen::VectorXd g = linear.reduce(H.gather(energy.gradient(x)));
   long n_inv = inverted(x);
   res.initial_energy = res.energy = E;
   res.initial_gradient_norm = res.gradient_norm = g.norm();
@@ -189,74 +196,40 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     auto t0 = Clock::now();
     energy.hessian(x, opt.project_psd && !exact, H);
     const LowRankHessian low = energy.low_rank_hessian(x, H);  // H - W M W^T (usually empty)
+    linear.set_hessian(H, low);
     info.t_assembly = since(t0);
 
-    auto& llt = impl_->llt;
     Eigen::VectorXd d;
     bool solved = false;
-    if (opt.reuse_factorization && impl_->have_factor && !fresh_factor) {
+    if (opt.reuse_factorization && linear.has_factor() && !fresh_factor) {
       t0 = Clock::now();
       const double eta = std::min(opt.max_forcing, std::sqrt(g.norm() / std::max(res.initial_gradient_norm, 1e-300)));
-      const auto Hs = H.matrix().selfadjointView<Eigen::Lower>();
-      auto apply = [&](const Eigen::VectorXd& v) {
-        Eigen::VectorXd out = Hs * v;
-        if (low.W.cols()) out.noalias() -= low.W * (low.M * (low.W.transpose() * v));
-        return out;
-      };
-      solved = preconditioned_cg(apply,
-                                 [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(impl_->llt.solve(v)); }, -g, eta,
-                                 opt.max_pcg_iterations, d, info.pcg_iterations);
+      solved = linear.lagged_solve(-g, eta, opt.max_pcg_iterations, d, info.pcg_iterations);
       info.t_solve = since(t0);
       res.pcg_iterations += info.pcg_iterations;
     }
     if (!solved) {
       t0 = Clock::now();
-      if (!impl_->analyzed) {
-        llt.analyzePattern(H.matrix());
-        impl_->analyzed = true;
-      }
-      // The projected Hessian is PSD; with few constraints it can be singular, so a
-      // growing diagonal shift is tried before giving up.
-      double shift = 0;
-      const double diag_scale = H.matrix().diagonal().cwiseAbs().maxCoeff();
-      llt.setShift(0);
-      llt.factorize(H.matrix());
-      if (llt.info() != Eigen::Success && exact) {  // not positive definite after all: project again
+      if (!linear.factorize(!exact, res.regularizations)) {  // the exact Hessian is not positive definite: project again
         leave_exact();
         energy.hessian(x, true, H);
-        llt.factorize(H.matrix());
+        linear.set_hessian(H, low);
+        linear.factorize(true, res.regularizations);
       }
-      while (llt.info() != Eigen::Success) {
-        shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
-        if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30)) {
-          impl_->have_factor = false;
-          throw SolverError("Hessian could not be factorized even with a diagonal shift (non-finite entries?)");
-        }
-        llt.setShift(shift);
-        llt.factorize(H.matrix());
-        ++res.regularizations;
-      }
-      impl_->have_factor = true;
       ++res.factorizations;
       info.factorized = true;
       info.t_factorization = since(t0);
       t0 = Clock::now();
-      d = -llt.solve(g);
-      if (low.W.cols()) {
-        // Woodbury: (H - W M W^T)^-1 = H^-1 + Z (I - M W^T Z)^-1 M Z^T with Z = H^-1 W.
-        const Eigen::MatrixXd Z = llt.solve(low.W);
-        const Eigen::MatrixXd K = Eigen::MatrixXd::Identity(low.M.rows(), low.M.rows()) - low.M * (low.W.transpose() * Z);
-        d += Z * K.fullPivLu().solve(low.M * (Z.transpose() * -g));
-      }
+      d = linear.solve(-g);
       info.t_solve += since(t0);
     }
     if (!d.allFinite()) throw SolverError("Newton direction is not finite");
 
     // Full step as vertex displacements.
     Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
-    H.scatter_add(d, 1.0, dx_full);
+    H.scatter_add(linear.expand(d), 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
-    const StepOutcome outcome = apply_newton_step(energy, tets_, local, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
+    const StepOutcome outcome = apply_newton_step(energy, tets, local, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
     if (outcome != StepOutcome::Taken) {
       if (exact) {  // retry on the projected Hessian before calling it a stall
         leave_exact();
@@ -270,10 +243,11 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
     }
     fresh_factor = false;
     const double g_before = g.norm();
-    g = H.gather(energy.gradient(x));
+    g = linear.reduce(H.gather(energy.gradient(x)));
     // Near the solution (full step accepted, |g| below 1% of the load) or where the projected
     // Hessian only converges linearly (|g| not halved by a full step).
-    if (opt.project_psd && opt.exact_hessian_near_solution && !exact && info.alpha == 1.0 && g.norm() < exact_retry_below &&
+    if (opt.project_psd && opt.exact_hessian_near_solution && linear.supports_exact_hessian() && !exact &&
+        info.alpha == 1.0 && g.norm() < exact_retry_below &&
         (g.norm() <= 1e-2 * std::max(res.initial_gradient_norm, opt.force_scale) || g.norm() > 0.5 * g_before))
       exact = true;
     info.gradient_norm = g.norm();
@@ -290,13 +264,103 @@ NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const New
       fresh_factor = true;
     }
   }
-  if (guard.restore_if_worse(x, E, n_inv, res, tets_.rows(), opt.max_inverted_fraction_after_stall))
-    g = H.gather(energy.gradient(x));
+  if (guard.restore_if_worse(x, E, n_inv, res, tets.rows(), opt.max_inverted_fraction_after_stall))
+    g = linear.reduce(H.gather(energy.gradient(x)));
   res.energy = E;
   res.gradient_norm = g.norm();
   res.inverted = n_inv;
   res.seconds = since(t_start);
   return res;
+}
+
+namespace {
+
+// The full-space solve: CHOLMOD supernodal Cholesky of the free-DOF Hessian, the symbolic
+// analysis once per pattern; a low-rank part by the Woodbury identity.
+class SparseCholeskySolve : public NewtonLinearSolve {
+ public:
+  SparseCholeskySolve() {
+    // A failed factorization is expected (the unprojected Hessian tried near the solution) and
+    // handled by the driver; CHOLMOD's own "not positive definite" lines on stderr would only alarm.
+    llt_.cholmod().print = 0;
+  }
+  Eigen::VectorXd reduce(const Eigen::VectorXd& g_free) const override { return g_free; }
+  Eigen::VectorXd expand(const Eigen::VectorXd& d) const override { return d; }
+  void set_hessian(const HessianAssembler& H, const LowRankHessian& low) override {
+    H_ = &H.matrix();
+    low_ = &low;
+  }
+  bool has_factor() const override { return have_factor_; }
+  bool lagged_solve(const Eigen::VectorXd& rhs, double eta, int max_iterations, Eigen::VectorXd& d, int& its) override {
+    const auto Hs = H_->selfadjointView<Eigen::Lower>();
+    auto apply = [&](const Eigen::VectorXd& v) {
+      Eigen::VectorXd out = Hs * v;
+      if (low_->W.cols()) out.noalias() -= low_->W * (low_->M * (low_->W.transpose() * v));
+      return out;
+    };
+    return preconditioned_cg(apply, [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(llt_.solve(v)); }, rhs, eta,
+                             max_iterations, d, its);
+  }
+  bool factorize(bool may_shift, int& regularizations) override {
+    if (!analyzed_) {
+      llt_.analyzePattern(*H_);
+      analyzed_ = true;
+    }
+    // The projected Hessian is PSD; with few constraints it can be singular, so a growing
+    // diagonal shift is tried before giving up.
+    llt_.setShift(0);
+    llt_.factorize(*H_);
+    if (llt_.info() != Eigen::Success && !may_shift) return false;
+    double shift = 0;
+    const double diag_scale = H_->diagonal().cwiseAbs().maxCoeff();
+    while (llt_.info() != Eigen::Success) {
+      shift = shift == 0 ? 1e-10 * std::max(diag_scale, 1e-30) : shift * 100;
+      if (!std::isfinite(shift) || shift > 1e2 * std::max(diag_scale, 1e-30)) {
+        have_factor_ = false;
+        throw SolverError("Hessian could not be factorized even with a diagonal shift (non-finite entries?)");
+      }
+      llt_.setShift(shift);
+      llt_.factorize(*H_);
+      ++regularizations;
+    }
+    have_factor_ = true;
+    return true;
+  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) override {
+    Eigen::VectorXd d = llt_.solve(rhs);
+    if (low_->W.cols()) {
+      // Woodbury: (H - W M W^T)^-1 = H^-1 + Z (I - M W^T Z)^-1 M Z^T with Z = H^-1 W.
+      const Eigen::MatrixXd Z = llt_.solve(low_->W);
+      const Eigen::MatrixXd K = Eigen::MatrixXd::Identity(low_->M.rows(), low_->M.rows()) - low_->M * (low_->W.transpose() * Z);
+      d += Z * K.fullPivLu().solve(low_->M * (Z.transpose() * rhs));
+    }
+    return d;
+  }
+  void forget_factor() override { have_factor_ = false; }
+
+ private:
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt_;
+  bool analyzed_ = false;
+  bool have_factor_ = false;  // llt_ holds a factor of some earlier Hessian (same pattern)
+  const Eigen::SparseMatrix<double>* H_ = nullptr;
+  const LowRankHessian* low_ = nullptr;
+};
+
+}  // namespace
+
+struct NewtonSolver::Impl {
+  SparseCholeskySolve linear;
+};
+
+NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
+    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {}
+
+NewtonSolver::~NewtonSolver() = default;
+
+void NewtonSolver::forget_factor() { impl_->linear.forget_factor(); }
+
+NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
+  return newton_minimize(energy, *assembler_, tets_, impl_->linear, x, opt);
 }
 
 }  // namespace btr

@@ -1,6 +1,8 @@
 // Quasi-static Newton solver (thesis Sec. 3.2): minimizes a TotalEnergy over the free
 // vertices with a PSD-projected Hessian, CHOLMOD supernodal Cholesky (symbolic analysis
 // once per solver, numeric factorization per iteration) and a backtracking line search.
+// One driver (newton_minimize) serves it and the subspace solver; they differ only in their
+// NewtonLinearSolve.
 #pragma once
 
 #include <functional>
@@ -25,8 +27,6 @@ enum class StopReason {
   Aborted,            ///< the callback asked to stop
 };
 std::string to_string(StopReason r);
-
-struct LineSearchOptions;
 
 struct IterationInfo {
   int iteration = 0;
@@ -91,12 +91,6 @@ struct NewtonResult {
   std::vector<IterationInfo> history;
 };
 
-/// Records an accepted iteration in `res` (history, totals), calls the callback and applies
-/// the stopping rules; returns true when the solve should stop (reason and converged set).
-/// Converged means the gradient criterion held (or, in the caller, a fresh full Newton step
-/// below step_tolerance); a damped step below it is a stall, never convergence.
-bool record_iteration(const IterationInfo& info, const NewtonOptions& opt, double gradient_tolerance, NewtonResult& res);
-
 /// Outcome of trying a Newton direction.
 /// TooSmall: the full (undamped) step is below step_tolerance; Stalled: the line search
 /// accepted a step, but one below step_tolerance while the full step is not.
@@ -111,35 +105,48 @@ enum class StepOutcome { Taken, TooSmall, NoDecrease, Stalled };
 /// Stalled, not converged) and returns false.
 bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOptions& opt, NewtonResult& res);
 
-/// The state at which a stall let the line search invert elements (recover_from_stall). A solve
-/// that then ends with more than max_inverted_fraction_after_stall of its tetrahedra newly
-/// inverted folded the mesh to meet its constraints (landmarks pulled through the chest
-/// wall): the state is restored and the solve reported as InvertedAfterStall. One that ends
-/// within it keeps its result, and the count is reported (soft tissue whose prone shape
-/// stands in for the rest shape: 1 to 6 of 7.1k elements at E = 400 Pa).
-struct InversionGuard {
-  bool armed = false;
-  Points x;
-  double energy = 0;
-  long inverted = 0;
-  /// Records the state the first time res.inversions_allowed is set.
-  void arm(const NewtonResult& res, const Points& x_now, double E, long n_inv);
-  /// At the end of a solve: restores the recorded state when x has more than
-  /// max_fraction x n_tets inversions beyond it; returns true when it did (x, E, n_inv and res
-  /// updated; the caller recomputes |g|).
-  bool restore_if_worse(Points& x_now, double& E, long& n_inv, NewtonResult& res, long n_tets, double max_fraction) const;
+/// The linear algebra of a Newton iteration: the one thing in which the full-space solver
+/// (sparse Cholesky, CHOLMOD) and the subspace solver (x = x0 + U q, dense LDLT of U^T H U)
+/// differ. The driver (newton_minimize) owns everything else: the stopping rules, the stall
+/// recovery, the inversion guard, the line search and the switch to the exact Hessian.
+/// Vectors are in the solve's coordinates (the free DOFs, or the subspace's), except where
+/// the name says free.
+class NewtonLinearSolve {
+ public:
+  virtual ~NewtonLinearSolve() = default;
+  /// The gradient in the solve's coordinates, from the free-DOF gradient.
+  virtual Eigen::VectorXd reduce(const Eigen::VectorXd& g_free) const = 0;
+  /// The free-DOF displacement of a step d.
+  virtual Eigen::VectorXd expand(const Eigen::VectorXd& d) const = 0;
+  /// The Hessian of this iteration: the assembler's matrix minus the low-rank part.
+  virtual void set_hessian(const HessianAssembler& H, const LowRankHessian& low) = 0;
+  /// A factor of an earlier Hessian (same pattern) that can precondition conjugate gradients.
+  virtual bool has_factor() const = 0;
+  /// Conjugate gradients on this iteration's Hessian preconditioned by the lagged factor, to
+  /// |H d - rhs| <= eta |rhs| within max_iterations; false when it did not get there.
+  virtual bool lagged_solve(const Eigen::VectorXd& rhs, double eta, int max_iterations, Eigen::VectorXd& d,
+                            int& iterations) = 0;
+  /// Factorizes this iteration's Hessian. With may_shift false, returns false if it is not
+  /// positive definite (the exact Hessian tried near the solution); with it, a growing diagonal
+  /// shift is tried (counted in regularizations) and SolverError thrown if none helps.
+  virtual bool factorize(bool may_shift, int& regularizations) = 0;
+  /// Solves with the last factor (the low-rank part included).
+  virtual Eigen::VectorXd solve(const Eigen::VectorXd& rhs) = 0;
+  /// Whether the unprojected Hessian may be used near the solution.
+  virtual bool supports_exact_hessian() const { return true; }
+  /// Drops the numeric factor.
+  virtual void forget_factor() = 0;
 };
 
-/// Shared by the full-space and subspace solvers: takes the step dx (#V by 3) with the line
-/// search from x (energy E, n_inv inverted tetrahedra), updating x, E, n_inv, the iteration's
-/// alpha / step norm / line-search time and the result's time totals. TooSmall: the full step
-/// is below the step tolerance (converged); NoDecrease: the line search found no decrease.
-StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
-                              const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
-                              long& n_inv, IterationInfo& info, NewtonResult& res);
-
-/// The line-search part of the options.
-LineSearchOptions line_search_options(const NewtonOptions& opt);
+/// Newton's method with a PSD-projected Hessian and a backtracking line search (thesis Sec.
+/// 3.2, Algorithm 1 in a subspace), the one driver of both solvers: minimizes `energy` over
+/// the free vertices of x in place (fixed vertices keep their positions); `linear` solves for
+/// the direction. Converged means the gradient criterion held (|g| <= abs_tol + rel_tol
+/// max(|g0|, force_scale), in the solve's coordinates), or a fresh full Newton step fell below
+/// step_tolerance; a damped step below it is a stall, never convergence. Throws SolverError if
+/// the energy is not finite at the start or the Hessian cannot be factorized.
+NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, const Tetrahedra& tets,
+                             NewtonLinearSolve& linear, Points& x, const NewtonOptions& opt);
 
 /// Newton solver bound to one sparsity pattern: the CHOLMOD symbolic analysis is done on
 /// the first solve and reused by every later solve with the same assembler.
@@ -151,9 +158,7 @@ class NewtonSolver {
   NewtonSolver(const NewtonSolver&) = delete;
   NewtonSolver& operator=(const NewtonSolver&) = delete;
 
-  /// Minimizes energy over the free vertices of x in place; fixed vertices keep their
-  /// positions. Throws SolverError if the energy is not finite at the start or the
-  /// Hessian cannot be factorized even after regularization.
+  /// newton_minimize with this solver's sparse Cholesky factorization.
   NewtonResult solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt);
 
   HessianAssembler& assembler() { return *assembler_; }
