@@ -6,13 +6,11 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/units.h"
-#include "breast_tumour_registration/fem/elastic_energy.h"
-#include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/validation.h"
 #include "breast_tumour_registration/registration/material_regions.h"
-#include "breast_tumour_registration/registration/rigid_regions.h"
+#include "breast_tumour_registration/registration/registration_step.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
 
 namespace btr {
@@ -49,37 +47,43 @@ void check_plausibility(const RegistrationModel& model, const RegistrationOption
 
 }  // namespace
 
+namespace {
+
+// A preset is a set of tolerances (what "converged" means for it) and a simulation mesh; the
+// iteration caps are generous safety limits, reported as not converged when hit. Mesh sizes
+// from the measured Pareto front (BENCHMARKS.md): on the phantom the accuracy saturates from
+// a 7 mm simulation mesh on.
+struct Preset {
+  const char* name;
+  double simulation_cell_size;    ///< [m]; 0: the scene's own mesh
+  int subspace_handles;
+  double gradient_rel_tolerance;  ///< landmark and surface Newton
+  double projection_tolerance;    ///< [m] surface step, on the distance to the fixed point
+};
+constexpr Preset kPresets[] = {
+    {"fast", 0.009, 30, 1e-3, 2e-4},
+    {"balanced", 0.007, 60, 1e-4, 1e-4},
+    {"accurate", 0.0, 60, 1e-6, 1e-5},
+};
+
+}  // namespace
+
 RegistrationOptions preset_options(const std::string& name) {
+  const Preset* p = nullptr;
+  for (const Preset& q : kPresets)
+    if (name == q.name) p = &q;
+  if (!p) throw InputError("unknown preset '" + name + "' (fast, balanced, accurate)");
   RegistrationOptions o;
   o.preset = name;
-  // A preset is a set of tolerances (what "converged" means for it) and a simulation mesh;
-  // the iteration caps are generous safety limits, reported as not converged when hit.
-  // Mesh sizes from the measured Pareto front (BENCHMARKS.md): on the phantom the accuracy
-  // saturates from a 7 mm simulation mesh on.
   o.landmark.newton.max_iterations = 60;
   o.surface.max_projections = 60;
   o.surface.newton_per_projection = 1;
   o.surface.newton.max_iterations = 30;
-  if (name == "fast") {
-    o.simulation_cell_size = 0.009;
-    o.landmark.subspace.handles = 30;
-    o.landmark.newton.gradient_rel_tolerance = 1e-3;
-    o.surface.newton.gradient_rel_tolerance = 1e-3;
-    o.surface.projection_tolerance = 2e-4;
-  } else if (name == "balanced") {
-    o.simulation_cell_size = 0.007;
-    o.landmark.subspace.handles = 60;
-    o.landmark.newton.gradient_rel_tolerance = 1e-4;
-    o.surface.newton.gradient_rel_tolerance = 1e-4;
-    o.surface.projection_tolerance = 1e-4;
-  } else if (name == "accurate") {  // the scene's own mesh
-    o.landmark.subspace.handles = 60;
-    o.landmark.newton.gradient_rel_tolerance = 1e-6;
-    o.surface.newton.gradient_rel_tolerance = 1e-6;
-    o.surface.projection_tolerance = 1e-5;
-  } else {
-    throw InputError("unknown preset '" + name + "' (fast, balanced, accurate)");
-  }
+  o.simulation_cell_size = p->simulation_cell_size;
+  o.landmark.subspace.handles = p->subspace_handles;
+  o.landmark.newton.gradient_rel_tolerance = p->gradient_rel_tolerance;
+  o.surface.newton.gradient_rel_tolerance = p->gradient_rel_tolerance;
+  o.surface.projection_tolerance = p->projection_tolerance;
   return o;
 }
 
@@ -184,157 +188,13 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   if (unloaded_in_preparation != prepared.unload.has_value())
     throw InputError(unloaded_in_preparation ? "the scene gives prone_gravity but the model was prepared without the unload step"
                                              : "the model was unloaded but the scene does not ask for it here");
-  // 0. Stiffness (then the unload at it): on a copy of the prepared model, which stays as it was.
-  std::optional<RegistrationModel> estimated;
-  if (r.steps.stiffness) {
-    StiffnessOptions so = opt.stiffness;
-    so.min_youngs_modulus = (*scene.youngs_modulus_range)[0];
-    so.max_youngs_modulus = (*scene.youngs_modulus_range)[1];
-    const StiffnessEstimate est =
-        estimate_stiffness(prepared, *scene.prone_gravity, scene.landmark_anchors, scene.landmark_supine, so);
-    estimated = prepared;
-    scale_stiffness(*estimated, est.scale);
-    set_rest_shape(*estimated, est.rest, unload_report(est.unload, prepared.prone));
-    StepReport rep;
-    rep.name = "stiffness";
-    rep.converged = est.converged;
-    rep.stop_reason = est.stop_reason;
-    rep.outer_iterations = static_cast<int>(est.evaluations.size());
-    rep.seconds = est.seconds - est.unload.seconds;  // the chosen candidate's unload is the unload step's
-    rep.stiffness_youngs_modulus = est.youngs_modulus;
-    rep.stiffness_misfit = est.misfit;
-    if (est.at_bound) rep.note = est.stop_reason;
-    r.reports.push_back(rep);
-    r.estimated_youngs_modulus = est.youngs_modulus;
-    r.stiffness_evaluations = est.evaluations;
-  }
-  const RegistrationModel& model = estimated ? *estimated : prepared;
-  // From the rest shape: stress-free, so every step travels rest -> supine only (from the prone
-  // shape over an unloaded rest, a soft breast would have to swing through prone -> supine).
-  // Without a deforming step the answer is the prone shape moved rigidly.
-  r.x = (r.steps.gravity || r.steps.landmarks || r.steps.surface) ? model.rest.V : model.prone;
-  if (model.unload) r.reports.push_back(*model.unload);  // done once, when the model was prepared
-
-  // 1. Rigid alignment. Kabsch on the landmarks is only a first guess: the landmarks sit on
-  // deforming skin, so their fit absorbs part of the breast's own sag. Where the landmark step
-  // runs, it solves the pose jointly with the deformation (gravity explains the sag); where
-  // rigid regions are given, ICP on them has the final word.
-  auto t0 = Clock::now();
-  Rigid T = Rigid::Identity();
-  if (opt.known_supine_to_model) {
-    T = *opt.known_supine_to_model;
-    r.steps.rigid_landmarks = r.steps.rigid_icp = false;
-  }
-  Points lm_supine, lm_prone;  // landmark pairs for the rigid step (none when it does not use them)
-  if (r.steps.rigid_landmarks) {
-    lm_supine = scene.landmark_supine;
-    lm_prone.resize(scene.landmark_anchors.size(), 3);
-    for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
-      lm_prone.row(i) = scene.landmark_anchors[i].position(model.prone).transpose();
-    T = kabsch(lm_supine, lm_prone);
-  }
-  const bool joint_pose = r.steps.rigid_landmarks && r.steps.landmarks;
-  if (r.steps.rigid_icp) {
-    // ICP starts from the landmark fit, the identity and the centroid-matched regions; the
-    // accepted result with the lowest inlier RMS wins, unless the regions are symmetric and
-    // fit turned poses equally well (then the landmarks decide, see rigid_regions.h).
-    std::vector<Rigid> starts = {T};
-    if (r.steps.rigid_landmarks) starts.push_back(Rigid::Identity());
-    Rigid centred = Rigid::Identity();
-    centred.translation() = (scene.prone_rigid->V.colwise().mean() - scene.supine_rigid->V.colwise().mean()).transpose();
-    starts.push_back(centred);
-    RigidRegionOptions ro = opt.rigid_regions;
-    ro.icp = opt.icp;
-    const RigidRegionChoice choice =
-        align_rigid_regions(scene.supine_rigid->V, scene.prone_rigid->V, starts, lm_supine, lm_prone, ro);
-    r.icp = choice.icp;
-    r.rigid_distinct_poses = choice.distinct_poses;
-    r.rigid_decided_by_landmarks = choice.decided_by_landmarks;
-    r.rigid_pose_undecided = choice.undecided;
-    r.rigid_note = choice.note;
-    // A symmetric ring that the landmarks resolve is information; one nothing resolves is a warning.
-    if (choice.undecided) r.warnings.push_back("rigid alignment: " + choice.note);
-    if (r.icp.accepted) {
-      T = r.icp.transform;
-      r.icp_used = true;
-    } else {
-      r.warnings.push_back("rigid alignment: " + r.icp.message + " from every initial guess; keeping the " +
-                           (r.steps.rigid_landmarks ? (joint_pose ? "pose solved with the landmarks" : "landmark alignment")
-                                                    : "identity alignment"));
-    }
-  } else if (r.steps.rigid_landmarks && !joint_pose) {
-    r.warnings.push_back("rigid alignment from landmarks only (Kabsch): landmarks on deforming skin bias it; add the "
-                         "landmark step, or give the rigid regions (chest_ring and supine.chest_ring) for ICP");
-  }
-  r.rigid_seconds = since(t0);
-
-  // 2. Optional gravity pre-step (thesis Sec. 5.2.2: gravity + surface).
-  if (r.steps.gravity) {
-    const auto tg = Clock::now();
-    TotalEnergy energy;
-    add_model_elastic_energy(energy, model);
-    auto g = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
-    energy.add(g);
-    StepSolvers local;
-    NewtonSolver& solver = (solvers ? *solvers : local).newton("gravity", model, energy.hessian_cliques());
-    NewtonOptions nopt = opt.gravity;
-    nopt.force_scale = g->total_weight();
-    if (callback) nopt.callback = [&](const IterationInfo& it) { return callback("gravity", it); };
-    const NewtonResult nr = solver.solve(energy, r.x, nopt);
-    StepReport rep;
-    rep.name = "gravity";
-    rep.converged = nr.converged;
-    rep.stop_reason = to_string(nr.reason);
-    rep.iterations = nr.iterations;
-    rep.seconds = since(tg);
-    rep.energy = nr.energy;
-    rep.gradient_norm = nr.gradient_norm;
-    rep.add_newton_profile(nr);
-    r.reports.push_back(rep);
-  }
-  // 3. Landmark-guided step; without a decisive rigid region, with the pose as unknowns.
-  Points targets = scene.landmark_supine.rows() ? transform_points(T, scene.landmark_supine) : Points();
-  if (r.steps.landmarks) {
-    if (joint_pose && !r.icp_used) {
-      Rigid moved = Rigid::Identity();
-      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback, &moved, solvers));
-      T = moved * T;
-      targets = transform_points(moved, targets);
-      r.pose_solved_with_landmarks = true;
-    } else {
-      r.reports.push_back(landmark_step(model, scene.landmark_anchors, targets, opt.landmark, r.x, callback, nullptr, solvers));
-      if (joint_pose) {
-        // ICP decided the pose; the joint fit (warm-started from this result) checks it.
-        Points xj = r.x;
-        Rigid moved = Rigid::Identity();
-        const StepReport check = landmark_step(model, scene.landmark_anchors, targets, opt.landmark, xj, {}, &moved, solvers);
-        r.pose_disagreement = max_displacement(moved, Rigid::Identity(), scene.prone_rigid->V);
-        if (r.pose_disagreement > opt.pose_disagreement_warning)
-          r.warnings.push_back("rigid alignment: ICP on the rigid regions and the pose solved with the landmarks differ by " +
-                               std::to_string(r.pose_disagreement * 1e3) + " mm on the rigid region (" +
-                               (check.converged ? "" : "joint fit not converged; ") +
-                               "ICP kept): check the landmark pairs and the rigid regions");
-      }
-    }
-  }
-  // The supine surface in the model frame as the rigid step left it, as a projector (AABB
-  // tree or kd-tree + normals), built once for the surface step and the skin-distance figure.
-  std::unique_ptr<SurfaceProjector> supine;
-  if (scene.supine_surface) supine = make_mesh_projector(transform_surface(T, *scene.supine_surface), opt.surface.target_normals);
-  else if (scene.supine_cloud) supine = make_cloud_projector(transform_points(T, *scene.supine_cloud));
-
-  // 4. Surface-guided step; where the pose was estimated without a decisive rigid region, the
-  // whole skin refines it jointly with the deformation.
-  Rigid to_projector = Rigid::Identity();  // model frame -> the projector's frame
-  if (r.steps.surface) {
-    const bool free_pose = (r.steps.rigid_landmarks || r.steps.rigid_icp) && !r.icp_used;
-    PosePoints lm{scene.landmark_anchors, targets};
-    r.reports.push_back(surface_step(model, *supine, opt.surface, r.x, callback, free_pose ? &to_projector : nullptr,
-                                     targets.rows() >= 3 ? &lm : nullptr, solvers));
-    r.pose_solved_with_surface = free_pose;
-    T = to_projector.inverse() * T;
-    if (targets.rows()) targets = transform_points(to_projector.inverse(), targets);
-  }
+  // The planned steps, in order, on one state (registration_step.h).
+  StepContext c(scene, prepared, opt, callback, solvers, r);
+  for (const auto& step : planned_step_sequence(r.steps)) step->run(c);
+  const RegistrationModel& model = c.model();
+  const Rigid T = c.supine_to_model;
+  const Rigid to_projector = c.to_projector;
+  const Points& targets = c.targets;
   r.supine_to_model = T;
   for (const auto& rep : r.reports) {
     r.converged = r.converged && rep.converged;
@@ -367,6 +227,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     }
     r.tumours.push_back(tr);
   }
+  const SurfaceProjector* supine = c.supine();  // for the skin distance (and the uncertainty)
   if (opt.uncertainty.enabled) {
     if (!r.steps.surface || !supine) {
       r.uncertainty_note = "not computed: it linearises the surface step's equilibrium, and the surface step did not run";
