@@ -41,16 +41,14 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     const RegistrationOptions opt = preset_options(preset);
-    SceneLoadOptions load;
-    load.tetrahedralize = false;
-    RegistrationEngine engine(load_scene(scene_path, load));
+    RegistrationEngine engine(load_scene(scene_path));
     const PreparedScene& prepared = engine.prepare(opt);
     RegistrationResult reference = engine.solve(opt);  // builds the solvers
     std::vector<double> fresh, model, kept;
     double worst_difference = 0;
     for (int i = 0; i < repeats; ++i) {
       auto t0 = std::chrono::steady_clock::now();
-      RegistrationEngine once(load_scene(scene_path, load));
+      RegistrationEngine once(load_scene(scene_path));
       const RegistrationResult a = once.solve(opt);
       fresh.push_back(since(t0));
       t0 = std::chrono::steady_clock::now();

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <string>
 
+#include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/io/scene.h"
@@ -59,7 +60,7 @@ int main(int argc, char** argv) {
       write_phantom_scene("/tmp/btr_bench_tracking_scene", o);
       scene_path = "/tmp/btr_bench_tracking_scene/scene.yaml";
     }
-    const Scene scene = load_scene(scene_path);
+    const Scene scene = load_meshed_scene(scene_path);
     if (!scene.supine_surface || !scene.supine_rigid || !scene.prone_rigid)
       throw InputError("the scene needs supine.surface, supine.chest_ring and chest_ring");
     const Rigid T_wp = pose(0.10, -0.05, 0.75, 0, 0, 20 * M_PI / 180);  // patient in the world (as btr_make_bag)

@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
   app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance target_normals");
   CLI11_PARSE(app, argc, argv);
   try {
-    const Scene scene = load_scene(scene_path);
+    const Scene scene = load_meshed_scene(scene_path);
     std::vector<Point> points;
     for (const std::string preset : {"fast", "balanced", "accurate"}) {
       for (double c : cells) points.push_back({"cell_size_mm", fmt(c), preset, c, preset_options(preset)});

@@ -22,20 +22,17 @@ std::string_view without_plus(std::string_view s) {
 }
 }  // namespace
 
-std::optional<double> parse_number(std::string_view s) {
+// The whole of s as a T, or nullopt.
+template <typename T>
+std::optional<T> parse_whole(std::string_view s) {
   s = without_plus(s);
-  double v = 0;
+  T v{};
   const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
   if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
   return v;
 }
 
-std::optional<int> parse_integer(std::string_view s) {
-  s = without_plus(s);
-  int v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size()) return std::nullopt;
-  return v;
-}
+std::optional<double> parse_number(std::string_view s) { return parse_whole<double>(s); }
+std::optional<int> parse_integer(std::string_view s) { return parse_whole<int>(s); }
 
 }  // namespace btr

@@ -13,7 +13,6 @@
 #include "breast_tumour_registration/fem/volume_form.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/surface_orientation.h"
-#include "breast_tumour_registration/geometry/tetrahedralize.h"
 #include "breast_tumour_registration/geometry/validation.h"
 #include "breast_tumour_registration/io/index_io.h"
 #include "breast_tumour_registration/io/markups_io.h"
@@ -53,42 +52,14 @@ const std::vector<std::string> kSceneKeys = {
 Scene load_scene_fields(const std::string& path);
 }  // namespace
 
-Scene load_scene(const std::string& path, const SceneLoadOptions& opt) {
+Scene load_scene(const std::string& path) {
   Scene s;
   try {
     s = load_scene_fields(path);
   } catch (const YAML::Exception& e) {  // a field read without a named check: still the file's fault
     throw InputError(path + ": " + e.what());
   }
-  if (s.prone_source && opt.tetrahedralize) mesh_prone(s, s.prone_source->cell_size.value_or(kDefaultCellSize));
   return s;
-}
-
-void mesh_prone(Scene& s, double cell_size) {
-  if (!s.prone_source) throw InputError(s.path + ": the prone model is a tetrahedral mesh already");
-  if (!(cell_size > 0) || !std::isfinite(cell_size))
-    throw InputError(s.path + ": field 'prone.cell_size_mm': must be positive");
-  const ProneSurfaceSource& src = *s.prone_source;
-  TetrahedralizeOptions topt;
-  topt.cell_size = cell_size;
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
-    s.prone = tetrahedralize(src.surface, topt);
-  } catch (const InputError& e) {
-    throw InputError(s.path + ": field 'prone.surface': " + e.what());
-  }
-  s.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  s.tetrahedralized = true;
-  try {
-    s.chest_wall = boundary_vertices_near_region(s.prone, src.surface, src.chest_wall, 1e-6 + topt.facet_distance_ratio * cell_size);
-  } catch (const InputError& e) {
-    throw InputError(s.path + ": field 'chest_wall': " + e.what());
-  }
-  if (src.landmarks.rows()) {
-    const BoundaryAttachment a = attach_to_boundary(s.prone, src.landmarks);
-    check_landmark_attachment(a, s.landmark_labels, s.path);
-    s.landmark_anchors = a.anchors;
-  }
 }
 
 void check_landmark_attachment(const BoundaryAttachment& a, const std::vector<std::string>& labels, const std::string& path) {

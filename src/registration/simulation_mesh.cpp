@@ -37,4 +37,37 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size) {
   return out;
 }
 
+void mesh_prone(Scene& s, double cell_size) {
+  if (!s.prone_source) throw InputError(s.path + ": the prone model is a tetrahedral mesh already");
+  if (!(cell_size > 0) || !std::isfinite(cell_size))
+    throw InputError(s.path + ": field 'prone.cell_size_mm': must be positive");
+  const ProneSurfaceSource& src = *s.prone_source;
+  TetrahedralizeOptions topt;
+  topt.cell_size = cell_size;
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    s.prone = tetrahedralize(src.surface, topt);
+  } catch (const InputError& e) {
+    throw InputError(s.path + ": field 'prone.surface': " + e.what());
+  }
+  s.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.tetrahedralized = true;
+  try {
+    s.chest_wall = boundary_vertices_near_region(s.prone, src.surface, src.chest_wall, 1e-6 + topt.facet_distance_ratio * cell_size);
+  } catch (const InputError& e) {
+    throw InputError(s.path + ": field 'chest_wall': " + e.what());
+  }
+  if (src.landmarks.rows()) {
+    const BoundaryAttachment a = attach_to_boundary(s.prone, src.landmarks);
+    check_landmark_attachment(a, s.landmark_labels, s.path);
+    s.landmark_anchors = a.anchors;
+  }
+}
+
+Scene load_meshed_scene(const std::string& path) {
+  Scene s = load_scene(path);
+  if (s.prone_source) mesh_prone(s, s.prone_source->cell_size.value_or(kDefaultCellSize));
+  return s;
+}
+
 }  // namespace btr

@@ -139,7 +139,8 @@ void RegistrationNode::load_scene() {
       ROS_WARN("scene has no chest_ring: depth tracking (ICP) is disabled");
     } else {
       // The supine breast bulges over the chest skin next to it: track only the part clear of it.
-      tracked_region_ = rigid_region_samples(*s.prone_rigid, boundary_surface(s.prone), params_.rigid_margin, 0.002);
+      // The prepared scene's mesh: a prone surface is meshed by the engine, not the loader.
+      tracked_region_ = rigid_region_samples(*s.prone_rigid, boundary_surface(p.scene.prone), params_.rigid_margin, 0.002);
       ROS_INFO("depth tracking on %ld samples of the chest ring (2 mm apart, farther than %.0f mm from the breast)",
                static_cast<long>(tracked_region_->points.rows()), params_.rigid_margin * 1e3);
     }

@@ -30,8 +30,7 @@ LabelPhantomFiles write_label_phantom(const std::string& scene_yaml, const std::
   namespace fs = std::filesystem;
   if (!(opt.muscle_thickness > 0) || !(opt.margin >= 0))
     throw InputError("label phantom: voxel size and muscle thickness must be positive, the margin >= 0");
-  SceneLoadOptions lo;
-  const Scene s = load_scene(scene_yaml, lo);
+  const Scene s = load_scene(scene_yaml);
   if (s.prone_source) throw InputError(scene_yaml + ": the label phantom needs the prone tetrahedral mesh (prone.tet_mesh)");
   const Mat3 R = phantom_to_ras();
   TetMesh prone{to_ras(s.prone.V), s.prone.T};

@@ -58,9 +58,7 @@ int main(int argc, char** argv) {
   try {
     auto t0 = std::chrono::steady_clock::now();
     prepare_output_folder(out_dir);
-    SceneLoadOptions load;
-    load.tetrahedralize = false;  // a prone surface is meshed once, below, at the size the call simulates
-    Scene scene = load_scene(scene_path, load);
+    Scene scene = load_scene(scene_path);  // a prone surface is meshed once, by the engine, at the size the call simulates
     if (!preset.empty()) scene.preset = preset;
     if (!steps.empty()) {
       scene.steps.clear();

@@ -18,7 +18,7 @@ struct Outcome {
 };
 
 Outcome register_independent(const std::string& variant, const std::string& fat = "3400") {
-  const Scene s = load_scene(std::string(BTR_TEST_DATA_DIR) + "/independent_truth_E" + fat + "/scene_" + variant + ".yaml");
+  const Scene s = load_meshed_scene(std::string(BTR_TEST_DATA_DIR) + "/independent_truth_E" + fat + "/scene_" + variant + ".yaml");
   std::vector<std::string> warnings;
   const RegistrationModel m = prepare_model(s, warnings);
   const RegistrationResult r = run_registration(s, m, preset_options(s.preset));

@@ -286,7 +286,7 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
   ASSERT_EQ(sum.tumour_centroids.size(), 5u);
 
   auto register_scene = [](const std::string& path) {
-    Scene s = load_scene(path);
+    Scene s = load_meshed_scene(path);
     s.steps = {"landmarks", "surface"};
     RegistrationEngine engine(s);
     return engine.solve(preset_options("balanced"));
@@ -310,7 +310,7 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
   }
   EXPECT_TRUE(lb.reports.back().converged) << test::step_stops(lb);
   // Results to Slicer: LPS files, the centroids as a point list that reads back where they are.
-  Scene ls = load_scene(dir + "/scene/scene.yaml");
+  Scene ls = load_meshed_scene(dir + "/scene/scene.yaml");
   RegistrationEngine engine(ls);
   const RegistrationResult r = engine.solve(preset_options("balanced"));
   const PreparedScene& prep = engine.prepare(preset_options("balanced"));
@@ -342,7 +342,7 @@ TEST(LabelMapRoundTrip, ScenesTakeSlicerPointListsAndNameAFiducialOffTheSkinAsAF
   const std::string lists = "landmarks: {prone: " + dir + "/prone.mrk.json, supine: " + dir + "/supine.mrk.json}\n";
   // Beside the phantom's files, whose paths are relative to its folder.
   test::write_text(src + "/scene_markups.yaml", text + lists + "patient_frame: RAS\n");
-  const Scene ok = load_scene(src + "/scene_markups.yaml");
+  const Scene ok = load_meshed_scene(src + "/scene_markups.yaml");
   ASSERT_EQ(ok.landmark_anchors.size(), s.landmark_anchors.size());
   for (size_t i = 0; i < s.landmark_anchors.size(); ++i) {
     EXPECT_LT((ok.landmark_anchors[i].position(ok.prone.V) - s.landmark_anchors[i].position(s.prone.V)).norm(), 1e-6);
@@ -350,15 +350,15 @@ TEST(LabelMapRoundTrip, ScenesTakeSlicerPointListsAndNameAFiducialOffTheSkinAsAF
   }
   // patient_frame is read with or without point lists (the Slicer outputs need it); a bad one is named.
   test::write_text(src + "/scene_frame_only.yaml", test::scene_text(src) + "patient_frame: LPS\n");
-  EXPECT_EQ(load_scene(src + "/scene_frame_only.yaml").patient_frame, PatientFrame::LPS);
+  EXPECT_EQ(load_meshed_scene(src + "/scene_frame_only.yaml").patient_frame, PatientFrame::LPS);
   test::write_text(src + "/scene_frame_bad.yaml", test::scene_text(src) + "patient_frame: RAI\n");
-  EXPECT_NE(message_of([&] { load_scene(src + "/scene_frame_bad.yaml"); }).find("field 'patient_frame'"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_meshed_scene(src + "/scene_frame_bad.yaml"); }).find("field 'patient_frame'"), std::string::npos);
   test::write_text(src + "/scene_markups_noframe.yaml", text + lists);
-  EXPECT_NE(message_of([&] { load_scene(src + "/scene_markups_noframe.yaml"); }).find("field 'patient_frame': missing"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_meshed_scene(src + "/scene_markups_noframe.yaml"); }).find("field 'patient_frame': missing"), std::string::npos);
   // A prone fiducial 30 mm off the skin: most often a list in another frame than it says.
   pr[1].position.z() += 0.03;
   write_markups(dir + "/prone.mrk.json", pr, PatientFrame::RAS, PatientFrame::LPS);
-  const std::string msg = message_of([&] { load_scene(src + "/scene_markups.yaml"); });
+  const std::string msg = message_of([&] { load_meshed_scene(src + "/scene_markups.yaml"); });
   EXPECT_NE(msg.find("prone landmark 'L1' is "), std::string::npos) << msg;
   EXPECT_NE(msg.find("coordinate system (LPS/RAS)"), std::string::npos) << msg;
 }

@@ -59,7 +59,7 @@ TEST(MaterialRegions, TheLabelledPhantomGivesEachTissueItsMaterial) {
   const long tumour = std::count(labels.begin(), labels.end(), kPhantomTumourLabel);
   EXPECT_GT(gland, 100);
   EXPECT_GT(tumour, 10);
-  const Scene s = load_scene(dir + "/scene.yaml");
+  const Scene s = load_meshed_scene(dir + "/scene.yaml");
   ASSERT_EQ(s.regions.size(), 2u);
   EXPECT_EQ(s.regions[0].name, "gland");
   EXPECT_NEAR(s.regions[0].youngs_modulus, 2 * s.material.youngs_modulus, 1e-9);  // the ratio, at the method's E
@@ -84,9 +84,9 @@ TEST(MaterialRegions, TheLabelledPhantomGivesEachTissueItsMaterial) {
 }
 
 TEST(MaterialRegions, ASurfaceRegionSelectsTheLabelledTetrahedra) {
-  const Scene by_label = load_scene(labelled_phantom_dir() + "/scene.yaml");
+  const Scene by_label = load_meshed_scene(labelled_phantom_dir() + "/scene.yaml");
   const Scene by_surface =
-      load_scene(scene_variant("gland_surface", "regions: [{name: gland, surface: gland_prone.obj, youngs_modulus: 6800}]"));
+      load_meshed_scene(scene_variant("gland_surface", "regions: [{name: gland, surface: gland_prone.obj, youngs_modulus: 6800}]"));
   std::vector<std::string> w;
   const RegistrationModel a = prepare_model(by_label, w), b = prepare_model(by_surface, w);
   std::set<int> la, lb;
@@ -102,7 +102,7 @@ TEST(MaterialRegions, ASurfaceRegionSelectsTheLabelledTetrahedra) {
 }
 
 TEST(MaterialRegions, TheSimulationMeshCarriesTheLabels) {
-  const Scene s = load_scene(labelled_phantom_dir() + "/scene.yaml");
+  const Scene s = load_meshed_scene(labelled_phantom_dir() + "/scene.yaml");
   const Scene coarse = with_simulation_mesh(s, 0.016);
   ASSERT_EQ(static_cast<Eigen::Index>(coarse.prone_labels.size()), coarse.prone.T.rows());
   auto gland_fraction = [](const TetMesh& m, const std::vector<int>& labels) {
@@ -126,26 +126,26 @@ TEST(MaterialRegions, TheSimulationMeshCarriesTheLabels) {
 TEST(MaterialRegions, BadRegionsAreClearErrors) {
   std::vector<std::string> w;
   expect_throw_with<InputError>(
-      [&] { prepare_model(load_scene(scene_variant("r2", "regions: [{name: gland, label: 7, youngs_modulus: 6800}]")), w); },
+      [&] { prepare_model(load_meshed_scene(scene_variant("r2", "regions: [{name: gland, label: 7, youngs_modulus: 6800}]")), w); },
       "no tetrahedron carries label 7");
   expect_throw_with<InputError>(
-      [] { load_scene(scene_variant("r3", "regions: [{name: gland, label: 2, surface: gland_prone.obj, youngs_modulus: 1}]")); },
+      [] { load_meshed_scene(scene_variant("r3", "regions: [{name: gland, label: 2, surface: gland_prone.obj, youngs_modulus: 1}]")); },
       "exactly one of 'label'");
   expect_throw_with<InputError>(
-      [] { load_scene(scene_variant("r4", "regions: [{name: gland, label: 2, youngs_modulus: 1, relative_stiffness: 2}]")); },
+      [] { load_meshed_scene(scene_variant("r4", "regions: [{name: gland, label: 2, youngs_modulus: 1, relative_stiffness: 2}]")); },
       "exactly one of 'youngs_modulus'");
-  expect_throw_with<InputError>([] { load_scene(scene_variant("r5", "regions: [{name: gland, label: 2, youngs_modulus: -5}]")); },
+  expect_throw_with<InputError>([] { load_meshed_scene(scene_variant("r5", "regions: [{name: gland, label: 2, youngs_modulus: -5}]")); },
                                 "youngs_modulus must be a positive");
-  expect_throw_with<InputError>([] { load_scene(scene_variant("r6", "regions: [{label: 2, youngs_modulus: 5}]")); },
+  expect_throw_with<InputError>([] { load_meshed_scene(scene_variant("r6", "regions: [{label: 2, youngs_modulus: 5}]")); },
                                 "regions[0].name");
-  expect_throw_with<InputError>([] { load_scene(scene_variant("r7", "regions: [{name: g, labl: 2, youngs_modulus: 5}]")); },
+  expect_throw_with<InputError>([] { load_meshed_scene(scene_variant("r7", "regions: [{name: g, labl: 2, youngs_modulus: 5}]")); },
                                 "did you mean");
   // A surface prone model has no cells to carry labels.
   const std::string surf = labelled_phantom_dir() + "/surface_prone.yaml";
   write_text(labelled_phantom_dir() + "/three.txt", "0 1 2\n");
   write_text(surf, "units: mm\nprone: {surface: prone_surface.obj}\nchest_wall: three.txt\ngravity: [0, 0, -9.81]\n"
                    "supine: {surface: supine_surface.obj}\nregions: [{name: gland, label: 2, youngs_modulus: 5}]\n");
-  expect_throw_with<InputError>([&] { load_scene(surf); }, "needs prone.tet_mesh");
+  expect_throw_with<InputError>([&] { load_meshed_scene(surf); }, "needs prone.tet_mesh");
 }
 
 TEST(MaterialRegions, AnEstimatedStiffnessScalesEveryRegion) {
@@ -153,7 +153,7 @@ TEST(MaterialRegions, AnEstimatedStiffnessScalesEveryRegion) {
   const std::string path = labelled_phantom_dir() + "/estimate.yaml";
   write_text(path, without_key(scene_text(labelled_phantom_dir()), "material") +
                        "material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]\n");
-  const Scene s = load_scene(path);
+  const Scene s = load_meshed_scene(path);
   std::vector<std::string> w;
   const RegistrationModel m = prepare_model(s, w);
   const RegistrationResult r = run_registration(s, m, preset_options("balanced"));

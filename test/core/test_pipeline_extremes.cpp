@@ -43,7 +43,7 @@ struct Outcome {
 };
 
 Outcome run(const std::string& scene_path, const std::function<void(Scene&, RegistrationOptions&)>& tweak = {}) {
-  Scene s = load_scene(scene_path);
+  Scene s = load_meshed_scene(scene_path);
   RegistrationOptions opt = preset_options("fast");
   if (tweak) tweak(s, opt);
   std::vector<std::string> warnings;

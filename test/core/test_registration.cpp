@@ -63,7 +63,7 @@ std::string soft_phantom_dir(const std::string& name) {
 }
 
 RegistrationResult register_scene(const std::string& path, const std::string& preset = "balanced") {
-  const Scene s = load_scene(path);
+  const Scene s = load_meshed_scene(path);
   std::vector<std::string> warnings;
   const RegistrationModel m = prepare_model(s, warnings);
   EXPECT_TRUE(warnings.empty());
@@ -119,7 +119,7 @@ TEST(Icp, ChecksItsResultAndRejectsBadClouds) {
 }
 
 TEST(SkinningSubspace, ReproducesAffineMapsAndKeepsTheChestWallFixed) {
-  const Scene s = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene s = load_meshed_scene(phantom_dir() + "/scene.yaml");
   std::vector<bool> fixed(s.prone.V.rows(), false);
   for (int v : s.chest_wall) fixed[v] = true;
   SubspaceOptions o;
@@ -196,7 +196,7 @@ TEST(Registration, WithoutTheRigidStepMisalignmentBreaksTheMethodAsInTheThesis) 
 }
 
 TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
-  const Scene full = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene full = load_meshed_scene(phantom_dir() + "/scene.yaml");
   PlannedSteps p = plan_steps(full);
   EXPECT_TRUE(p.rigid_landmarks && p.rigid_icp && p.landmarks && p.surface);
   EXPECT_FALSE(p.gravity);
@@ -228,7 +228,7 @@ TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
   listed.steps = {"unload", "surface"};
   expect_throw_with<InputError>([&] { plan_steps(listed); }, "'unload' needs the field 'prone_gravity'");
   const std::string bad_path = scene_with("prone_gravity: [0, 0, 0]", "zero_prone_gravity");
-  expect_throw_with<InputError>([&] { load_scene(bad_path); }, "prone_gravity");
+  expect_throw_with<InputError>([&] { load_meshed_scene(bad_path); }, "prone_gravity");
   // A model prepared for another plan is refused, not silently used.
   std::vector<std::string> w;
   const RegistrationModel plain = prepare_model(full, w);
@@ -264,7 +264,7 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   EXPECT_FALSE(b.converged);
 
   // What the step needs is named.
-  Scene s = load_scene(scene_with(estimate, "estimate", d));
+  Scene s = load_meshed_scene(scene_with(estimate, "estimate", d));
   Scene no_gravity = s;
   no_gravity.prone_gravity.reset();
   expect_throw_with<InputError>([&] { plan_steps(no_gravity); }, "'estimate' needs the field 'prone_gravity'");
@@ -273,7 +273,7 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   few.landmark_supine.conservativeResize(2, 3);
   expect_throw_with<InputError>([&] { plan_steps(few); }, "needs >= 3 landmarks");
   expect_throw_with<InputError>(
-      [&] { load_scene(scene_with("material: {youngs_modulus: 600, youngs_modulus_range: [100, 1000]}", "range_only", d)); },
+      [&] { load_meshed_scene(scene_with("material: {youngs_modulus: 600, youngs_modulus_range: [100, 1000]}", "range_only", d)); },
       "only with 'youngs_modulus: estimate'");
 }
 
@@ -284,7 +284,7 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
 // point. On a soft phantom told its E and prone gravity that limit is the truth.
 TEST(SurfaceStep, InterpolatedNormalsContractToTheFixedPointOnASoftBreast) {
   const std::string d = soft_phantom_dir("phantom12_soft_normals");
-  const Scene s = load_scene(scene_with("material: {youngs_modulus: 600, poisson_ratio: 0.49, density: 1000}\n"
+  const Scene s = load_meshed_scene(scene_with("material: {youngs_modulus: 600, poisson_ratio: 0.49, density: 1000}\n"
                                         "prone_gravity: [0, 0, 9.81]",
                                         "soft_told", d));
   std::vector<std::string> warnings;
@@ -348,49 +348,49 @@ TEST(Unload, InThePipelineItBeatsTheProneShapeAsRestOnASoftBreast) {
 TEST(SceneErrors, NameTheFieldAtFault) {
   const std::string d = btr::test::temp_dir();
   btr::test::write_text(d + "/a.yaml", "units: mm\n");
-  expect_throw_with<InputError>([&] { load_scene(d + "/a.yaml"); }, "field 'prone'");
-  expect_throw_with<InputError>([&] { load_scene(d + "/missing.yaml"); }, "cannot open scene");
+  expect_throw_with<InputError>([&] { load_meshed_scene(d + "/a.yaml"); }, "field 'prone'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(d + "/missing.yaml"); }, "cannot open scene");
   btr::test::write_text(d + "/b.yaml", "units: [\n");
-  expect_throw_with<InputError>([&] { load_scene(d + "/b.yaml"); }, "YAML syntax error");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("units: furlong", "bad_units")); }, "field 'units'");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("steps: [rigid, teleport]", "bad_step")); }, "unknown step 'teleport'");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("preset: turbo", "bad_preset")); }, "field 'preset'");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("material: {youngs_modulus: -5}", "bad_E")); }, "field 'material'");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("chest_wall: nowhere.txt", "bad_wall")); }, "field 'chest_wall'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(d + "/b.yaml"); }, "YAML syntax error");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("units: furlong", "bad_units")); }, "field 'units'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("steps: [rigid, teleport]", "bad_step")); }, "unknown step 'teleport'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("preset: turbo", "bad_preset")); }, "field 'preset'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("material: {youngs_modulus: -5}", "bad_E")); }, "field 'material'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("chest_wall: nowhere.txt", "bad_wall")); }, "field 'chest_wall'");
   btr::test::write_text(phantom_dir() + "/bad_landmarks.csv", "prone_index,supine_index\n99999,1\n");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("landmarks: bad_landmarks.csv", "bad_lm")); }, "field 'landmarks'");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("landmarks: bad_landmarks.csv", "bad_lm")); }, "field 'landmarks'");
 }
 
 // Issue 10: inputs say what they mean. Unknown and misplaced keys name the nearest valid one,
 // wrong types name the field, units and gravity must be stated, and a metre mesh read as
 // millimetres is called a units mistake (btr_register maps every InputError to exit code 2).
 TEST(SceneErrors, KeysTypesUnitsAndGravityAreChecked) {
-  expect_throw_with<InputError>([&] { load_scene(scene_with("cell_size_mm: 5", "misplaced")); },
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("cell_size_mm: 5", "misplaced")); },
                                 "field 'cell_size_mm': unknown key (did you mean prone.cell_size_mm?)");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("prone: {tetmesh: prone.vtk}", "misspelt")); },
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("prone: {tetmesh: prone.vtk}", "misspelt")); },
                                 "field 'prone.tetmesh': unknown key (did you mean prone.tet_mesh?)");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("units: [mm]", "units_list")); },
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("units: [mm]", "units_list")); },
                                 "field 'units': expected a single value");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("material: {youngs_modulus: soft}", "E_text")); },
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("material: {youngs_modulus: soft}", "E_text")); },
                                 "field 'material.youngs_modulus': expected a number, got 'soft'");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("preset: {name: fast}", "preset_map")); },
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("preset: {name: fast}", "preset_map")); },
                                 "field 'preset': expected a single value");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("tumours: [top]", "tumour_text")); },
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("tumours: [top]", "tumour_text")); },
                                 "field 'tumours[0]': expected a mapping");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("units: m", "metre_units")); }, "is `units` right (mm or m)?");
-  expect_throw_with<InputError>([&] { load_scene(scene_with("gravity: [0, 0, 0]", "zero_g")); }, "field 'gravity': must not be zero");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("units: m", "metre_units")); }, "is `units` right (mm or m)?");
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("gravity: [0, 0, 0]", "zero_g")); }, "field 'gravity': must not be zero");
   // Without `units` or `gravity` at all.
   auto without = [&](const std::string& key, const std::string& name) {
     btr::test::write_text(phantom_dir() + "/" + name + ".yaml", without_key(phantom_scene_text(), key));
     return phantom_dir() + "/" + name + ".yaml";
   };
-  expect_throw_with<InputError>([&] { load_scene(without("units", "no_units")); }, "field 'units': missing");
-  expect_throw_with<InputError>([&] { load_scene(without("gravity", "no_gravity")); }, "field 'gravity': missing");
+  expect_throw_with<InputError>([&] { load_meshed_scene(without("units", "no_units")); }, "field 'units': missing");
+  expect_throw_with<InputError>([&] { load_meshed_scene(without("gravity", "no_gravity")); }, "field 'gravity': missing");
 }
 
 TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   // The prone model given as a surface: indices refer to the surface and must survive meshing.
-  const Scene tets = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene tets = load_meshed_scene(phantom_dir() + "/scene.yaml");
   const std::string d = phantom_dir();
   SurfaceMesh skin;
   std::vector<int> to_tet;
@@ -411,7 +411,7 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   const std::string path = scene_with(
       "prone: {surface: prone_skin_surface.obj, cell_size_mm: 12}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
       "from_surface");
-  const Scene s = load_scene(path);
+  const Scene s = load_meshed_scene(path);
   EXPECT_TRUE(s.tetrahedralized);
   for (int v : s.chest_wall) EXPECT_LT(std::abs(s.prone.V(v, 2)), 1e-6);
   for (size_t i = 0; i < s.landmark_anchors.size(); ++i)
@@ -421,9 +421,7 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
 
   // Meshed once (issue 10): loaded without meshing, then meshed by the caller at the size it
   // simulates, after which the preset sees no finer mesh to coarsen.
-  SceneLoadOptions lazy;
-  lazy.tetrahedralize = false;
-  Scene l = load_scene(path, lazy);
+  Scene l = load_scene(path);
   EXPECT_FALSE(l.tetrahedralized);
   EXPECT_EQ(l.prone.T.rows(), 0);
   ASSERT_TRUE(l.prone_source.has_value());
@@ -442,7 +440,7 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   long n_flipped = 0;
   for (Eigen::Index f = 0; f < flipped.F.rows(); f += 7, ++n_flipped) flipped.F.row(f) = Eigen::RowVector3i(flipped.F(f, 0), flipped.F(f, 2), flipped.F(f, 1));
   write_surface(d + "/prone_flipped.obj", flipped, LengthUnit::Millimetre);
-  const Scene fs = load_scene(scene_with(
+  const Scene fs = load_meshed_scene(scene_with(
       "prone: {surface: prone_flipped.obj, cell_size_mm: 12}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
       "from_flipped"));
   ASSERT_EQ(fs.warnings.size(), 1u);
@@ -452,7 +450,7 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   SurfaceMesh inside_out = skin;
   inside_out.F.col(1).swap(inside_out.F.col(2));
   write_surface(d + "/prone_inside_out.obj", inside_out, LengthUnit::Millimetre);
-  const Scene io = load_scene(scene_with(
+  const Scene io = load_meshed_scene(scene_with(
       "prone: {surface: prone_inside_out.obj, cell_size_mm: 12}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
       "from_inside_out"));
   ASSERT_EQ(io.warnings.size(), 1u);
@@ -460,7 +458,7 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
 }
 
 TEST(Outputs, ReportAndPictureAreWritten) {
-  const Scene s = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene s = load_meshed_scene(phantom_dir() + "/scene.yaml");
   std::vector<std::string> w;
   const RegistrationModel m = prepare_model(s, w);
   const RegistrationResult r = run_registration(s, m, preset_options("fast"));
@@ -523,7 +521,7 @@ const std::string& soft_phantom_dir() {
 }  // namespace
 
 TEST(RigidAlignment, RigidRegionsOverruleLandmarksOnDeformingSkin) {
-  const Scene s = load_scene(soft_phantom_dir() + "/scene.yaml");
+  const Scene s = load_meshed_scene(soft_phantom_dir() + "/scene.yaml");
   Points prone_lm(s.landmark_anchors.size(), 3);
   for (size_t i = 0; i < s.landmark_anchors.size(); ++i) prone_lm.row(i) = s.landmark_anchors[i].position(s.prone.V).transpose();
   const Rigid landmark_fit = kabsch(s.landmark_supine, prone_lm);
@@ -560,7 +558,7 @@ TEST(StiffTumour, KeepsTheTumourShapeCloserToTheTruth) {
 
 TEST(Registration, SupinePointCloudInsteadOfASurface) {
   // The supine scan as unorganized points (e.g. from a depth camera or a laser scanner).
-  const Scene base = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene base = load_meshed_scene(phantom_dir() + "/scene.yaml");
   std::ofstream xyz(phantom_dir() + "/supine_points.xyz");
   xyz << "# x y z [mm]\n";
   for (Eigen::Index i = 0; i < base.supine_surface->V.rows(); ++i)
@@ -568,7 +566,7 @@ TEST(Registration, SupinePointCloudInsteadOfASurface) {
         << base.supine_surface->V(i, 2) * 1e3 << '\n';
   xyz.close();
   const std::string path = scene_with("supine:\n  cloud: supine_points.xyz\n  chest_ring: chest_ring.obj", "cloud_scene");
-  const Scene s = load_scene(path);
+  const Scene s = load_meshed_scene(path);
   ASSERT_TRUE(s.supine_cloud);
   EXPECT_FALSE(s.supine_surface);
   EXPECT_EQ(s.supine_cloud->rows(), base.supine_surface->V.rows());
@@ -580,7 +578,7 @@ TEST(Registration, SupinePointCloudInsteadOfASurface) {
 }
 
 TEST(SimulationMesh, ACoarserMeshKeepsChestWallLandmarksAndAccuracy) {
-  const Scene scene = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene scene = load_meshed_scene(phantom_dir() + "/scene.yaml");
   RegistrationOptions opt = preset_options("balanced");
   opt.simulation_cell_size = 0.012;  // the scene's own 12 mm: keep the scene's mesh
   EXPECT_FALSE(simulation_scene(scene, opt).has_value());
@@ -669,7 +667,7 @@ TEST(SurfaceProjector, InterpolatedNormalsAreContinuousAcrossEdgesAndCloserToThe
 TEST(Registration, APartialScanIsNotPulledOntoItsBorder) {
   // The supine surface as a depth camera would leave it: one side of the breast missing.
   // Skin hidden from the scan must not be held to the scan's edge.
-  const Scene base = load_scene(phantom_dir() + "/scene.yaml");
+  const Scene base = load_meshed_scene(phantom_dir() + "/scene.yaml");
   SurfaceMesh partial = *base.supine_surface;
   std::vector<Eigen::Vector3i> kept;
   for (Eigen::Index f = 0; f < partial.F.rows(); ++f) {
@@ -709,7 +707,7 @@ TEST(Landmarks, DuplicatesAreMergedAndHandlesCapped) {
   while (std::getline(is, line))
     if (!line.empty()) rows += line + "\n" + line + "\n", ++n;
   btr::test::write_text(phantom_dir() + "/landmarks_twice.csv", "prone_index,x,y,z\n" + rows);
-  const Scene s = load_scene(scene_with("landmarks: landmarks_twice.csv", "landmarks_twice"));
+  const Scene s = load_meshed_scene(scene_with("landmarks: landmarks_twice.csv", "landmarks_twice"));
   EXPECT_EQ(s.landmark_supine.rows(), n);
   ASSERT_FALSE(s.warnings.empty());
   EXPECT_NE(s.warnings[0].find(std::to_string(n) + " duplicate pairs merged"), std::string::npos) << s.warnings[0];

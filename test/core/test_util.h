@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/io/scene.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
@@ -43,7 +44,7 @@ inline const std::string& coarse_phantom_dir() {
 }
 
 inline const Scene& coarse_phantom_scene() {
-  static const Scene s = load_scene(coarse_phantom_dir() + "/scene.yaml");
+  static const Scene s = load_meshed_scene(coarse_phantom_dir() + "/scene.yaml");
   return s;
 }
 

@@ -68,7 +68,7 @@ constexpr double kDefaultCellSize = 0.006;
 struct Scene {
   std::string path;
   LengthUnit units = LengthUnit::Millimetre;
-  TetMesh prone;                         ///< model frame (empty until mesh_prone for a surface not yet meshed)
+  TetMesh prone;                         ///< model frame (empty for a prone surface until mesh_prone)
   std::optional<ProneSurfaceSource> prone_source;  ///< the prone model was given as a surface
   bool tetrahedralized = false;          ///< prone was meshed from prone_source
   double tetrahedralize_seconds = 0;
@@ -107,20 +107,12 @@ Rigid misalignment_from_degrees_mm(const Vec3& rotation_deg, const Vec3& transla
 /// truth) by `m`, as if the supine scan had been taken misaligned; composes s.misalignment.
 void apply_misalignment(Scene& s, const Rigid& m);
 
-/// Loads and validates a scene. Throws InputError naming the file and field at fault: a
-/// missing `units` or `gravity`, an unknown or misplaced key (with the nearest valid one), a
-/// value of the wrong type, a mesh whose size says the units are wrong.
-struct SceneLoadOptions {
-  /// Mesh a prone surface at load (at prone.cell_size_mm, else kDefaultCellSize). false:
-  /// leave it to the caller's mesh_prone, e.g. at the size its preset simulates, so that the
-  /// surface is tetrahedralized once.
-  bool tetrahedralize = true;
-};
-Scene load_scene(const std::string& path, const SceneLoadOptions& opt = {});
-
-/// Tetrahedralizes s.prone_source at cell_size [m] and re-attaches the chest wall and the
-/// landmarks to the tetrahedra. InputError naming the field on failure.
-void mesh_prone(Scene& s, double cell_size);
+/// Loads and validates a scene: parses every field and reads the files it names, and meshes
+/// nothing (a prone surface stays in prone_source, s.prone empty, for the registration layer's
+/// mesh_prone at the size a call simulates). Throws InputError naming the file and field at
+/// fault: a missing `units` or `gravity`, an unknown or misplaced key (with the nearest valid
+/// one), a value of the wrong type, a mesh whose size says the units are wrong.
+Scene load_scene(const std::string& path);
 
 /// A prone landmark further than this from the prone skin is a frame or units mistake [m].
 constexpr double kMaxLandmarkSkinDistance = 0.010;

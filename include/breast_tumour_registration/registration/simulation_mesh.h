@@ -1,4 +1,5 @@
-// The simulation mesh as a speed/accuracy knob: the prone model re-tetrahedralized from its
+// Meshing a scene's prone model: a prone surface tetrahedralized (the loader meshes nothing),
+// and the simulation mesh as a speed/accuracy knob: the prone model re-tetrahedralized from its
 // boundary surface at another cell size. The tumours are embedded in whatever mesh the model
 // uses, so a coarser simulation mesh keeps the tumour geometry and only coarsens the
 // deformation field (BENCHMARKS.md measures the trade).
@@ -14,5 +15,15 @@ namespace btr {
 /// all other data is unchanged (prepare_model embeds the tumours in the new mesh). Throws
 /// InputError for cell_size <= 0 or a prone boundary that cannot be meshed.
 Scene with_simulation_mesh(const Scene& scene, double cell_size);
+
+/// Tetrahedralizes a scene's prone surface (s.prone_source) at cell_size [m] and attaches the
+/// chest wall and the landmarks to the tetrahedra. InputError naming the field on failure, or
+/// when the prone model is a tetrahedral mesh already.
+void mesh_prone(Scene& s, double cell_size);
+
+/// load_scene, then a prone surface meshed at its prone.cell_size_mm (else kDefaultCellSize):
+/// for callers that need the tetrahedra without an engine (which meshes at the size a call
+/// simulates instead).
+Scene load_meshed_scene(const std::string& path);
 
 }  // namespace btr
