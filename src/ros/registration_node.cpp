@@ -55,18 +55,18 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
   read_param(pnh, "working_frame", p.working_frame, "a frame name");
   read_param(pnh, "model_frame", p.model_frame, "a frame name");
   read_param(pnh, "preset", p.preset, "fast, balanced or accurate");
-  read_param(pnh, "voxel_size", p.voxel_size, "a number [m]");
+  read_param(pnh, "voxel_size", p.tracker.voxel_size, "a number [m]");
   read_param(pnh, "icp_every_n", p.icp_every_n, "an integer");
-  read_param(pnh, "icp_max_iterations", p.icp_max_iterations, "an integer");
-  read_param(pnh, "icp_max_correspondence", p.icp_max_correspondence, "a number [m]");
+  read_param(pnh, "icp_max_iterations", p.tracker.max_iterations, "an integer");
+  read_param(pnh, "icp_max_correspondence", p.tracker.max_correspondence, "a number [m]");
   read_param(pnh, "max_depth_edge", p.max_depth_edge, "a number [m]");
   read_param(pnh, "scan_smoothing_pixels", p.scan_smoothing_pixels, "a number [px]");
   read_param(pnh, "use_landmarks", p.use_landmarks, "true or false");
   read_param(pnh, "min_tracked_clouds", p.min_tracked_clouds, "an integer");
   read_param(pnh, "rigid_margin", p.rigid_margin, "a number [m]");
-  read_param(pnh, "smoothing_clouds", p.smoothing_clouds, "an integer");
-  p.roi_min = read_vec3(pnh, "roi_min", p.roi_min);
-  p.roi_max = read_vec3(pnh, "roi_max", p.roi_max);
+  read_param(pnh, "smoothing_clouds", p.tracker.smoothing_clouds, "an integer");
+  p.tracker.roi_min = read_vec3(pnh, "roi_min", p.tracker.roi_min);
+  p.tracker.roi_max = read_vec3(pnh, "roi_max", p.tracker.roi_max);
   std::vector<double> pose;
   if (pnh.hasParam("initial_model_pose") && !pnh.getParam("initial_model_pose", pose))
     throw InputError("parameter ~initial_model_pose has the wrong type (expected [x, y, z, roll, pitch, yaw])");
@@ -75,13 +75,13 @@ NodeParameters read_node_parameters(const ros::NodeHandle& pnh) {
     p.initial_model_pose = rigid_from_rpy(Vec3(pose[0], pose[1], pose[2]), Vec3(pose[3], pose[4], pose[5]));
   }
   preset_options(p.preset);  // throws for an unknown preset
-  if (!(p.voxel_size >= 0) || p.icp_every_n < 1 || p.icp_max_iterations < 1 || !(p.icp_max_correspondence > 0) ||
-      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0) || p.smoothing_clouds < 1 ||
+  if (!(p.tracker.voxel_size >= 0) || p.icp_every_n < 1 || p.tracker.max_iterations < 1 || !(p.tracker.max_correspondence > 0) ||
+      !(p.max_depth_edge > 0) || p.min_tracked_clouds < 1 || !(p.rigid_margin >= 0) || p.tracker.smoothing_clouds < 1 ||
       !(p.scan_smoothing_pixels >= 0 && p.scan_smoothing_pixels <= 50))
     throw InputError("parameters ~icp_max_correspondence, ~max_depth_edge must be > 0, ~scan_smoothing_pixels in [0, 50], ~voxel_size and "
                      "~rigid_margin >= 0, and ~icp_every_n, ~icp_max_iterations, ~min_tracked_clouds, "
                      "~smoothing_clouds >= 1");
-  if ((p.roi_max - p.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
+  if ((p.tracker.roi_max - p.tracker.roi_min).minCoeff() <= 0) throw InputError("parameter ~roi_max must exceed ~roi_min on every axis");
   return p;
 }
 
@@ -203,14 +203,7 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     std::unique_lock<std::mutex> lock(state_mutex_);
     if (!tracker_ && tracked_region_) {
       // Without a rigid region there is nothing to track; the cloud is still kept (ROI only).
-      DepthTrackerOptions o;
-      o.voxel_size = params_.voxel_size;
-      o.max_iterations = params_.icp_max_iterations;
-      o.max_correspondence = params_.icp_max_correspondence;
-      o.smoothing_clouds = params_.smoothing_clouds;
-      o.roi_min = params_.roi_min;
-      o.roi_max = params_.roi_max;
-      tracker_.emplace(*tracked_region_, params_.initial_model_pose, o);
+      tracker_.emplace(*tracked_region_, params_.initial_model_pose, params_.tracker);
     }
     const bool track = tracker_ && !registering_ && clouds_seen_ % params_.icp_every_n == 0;
     TrackingResult r;
@@ -218,7 +211,7 @@ void RegistrationNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
       r = tracker_->process(c.points, T);
     } else {
       // Keep the cloud in the working frame (ROI applied) without aligning it.
-      to_working_frame(c.points, T, params_.roi_min, params_.roi_max);
+      to_working_frame(c.points, T, params_.tracker.roi_min, params_.tracker.roi_max);
     }
     latest_cloud_ = std::move(c.points);
     latest_width_ = c.organized ? c.width : 0;

@@ -29,18 +29,18 @@ struct NodeParameters {
   std::string working_frame = "world";    ///< ~working_frame: frame of the results
   std::string model_frame = "breast_model";  ///< ~model_frame: the prone model's frame (tf child)
   std::string preset = "balanced";        ///< ~preset
-  double voxel_size = 0.002;              ///< ~voxel_size [m]: cloud downsampling for tracking ICP (0: none)
-  Vec3 roi_min = Vec3::Constant(-1e9), roi_max = Vec3::Constant(1e9);  ///< ~roi_min/~roi_max [m], working frame
+  /// The depth tracking, read from ~voxel_size (cloud downsampling [m], 0: none),
+  /// ~icp_max_iterations (per cloud, warm-started), ~icp_max_correspondence [m], ~roi_min and
+  /// ~roi_max ([m], working frame) and ~smoothing_clouds (the published pose is the mean of
+  /// this many, 1: none); the rest as DepthTrackerOptions has it.
+  DepthTrackerOptions tracker;
   int icp_every_n = 1;                    ///< ~icp_every_n: track on every n-th cloud
-  int icp_max_iterations = 10;            ///< ~icp_max_iterations per cloud (warm-started)
-  double icp_max_correspondence = 0.01;   ///< ~icp_max_correspondence [m]
   Rigid initial_model_pose = Rigid::Identity();  ///< ~initial_model_pose [x y z roll pitch yaw], working frame
   double max_depth_edge = 0.01;           ///< ~max_depth_edge [m]: no surface across depth jumps
   double scan_smoothing_pixels = 2.0;     ///< ~scan_smoothing_pixels: Gaussian sigma of the scan's smoothing before registration (0: none)
   bool use_landmarks = true;              ///< ~use_landmarks with the live cloud
   int min_tracked_clouds = 10;            ///< ~min_tracked_clouds: consecutive ICP successes before registering
   double rigid_margin = 0.015;            ///< ~rigid_margin [m]: track chest-ring points this far from the breast
-  int smoothing_clouds = 10;              ///< ~smoothing_clouds: the published pose is the mean of this many (1: none)
 };
 
 /// Reads the parameters with defaults; throws InputError naming a parameter out of range.
