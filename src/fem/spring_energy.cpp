@@ -24,11 +24,17 @@ Vec3 unit_normal(const Vec3& normal) {
 }  // namespace
 
 void SpringEnergy::add(const Anchor& anchor, const Vec3& target, const Mat3& K) {
-  if (!target.allFinite()) throw InputError("spring target is not finite");
   if (!K.allFinite() || (K - K.transpose()).cwiseAbs().maxCoeff() > 1e-12 * K.cwiseAbs().maxCoeff())
     throw InputError("spring stiffness must be a finite symmetric 3x3 matrix");
   const double lowest = Eigen::SelfAdjointEigenSolver<Mat3>(K, Eigen::EigenvaluesOnly).eigenvalues()[0];
   if (lowest < -1e-12 * K.cwiseAbs().maxCoeff()) throw InputError("spring stiffness must be positive semi-definite");
+  push(anchor, target, K);
+}
+
+// The metrics below are symmetric PSD by construction (finite weights >= 0, a unit normal):
+// the surface step adds one per held skin vertex and projection, without an eigensolve each.
+void SpringEnergy::push(const Anchor& anchor, const Vec3& target, const Mat3& K) {
+  if (!target.allFinite()) throw InputError("spring target is not finite");
   anchors_.push_back(anchor);
   targets_.push_back(target);
   stiffness_.push_back(K);
@@ -36,13 +42,13 @@ void SpringEnergy::add(const Anchor& anchor, const Vec3& target, const Mat3& K) 
 
 void SpringEnergy::add_point(const Anchor& anchor, const Vec3& target, double weight) {
   check_weight(weight, "point");
-  add(anchor, target, weight * Mat3::Identity());
+  push(anchor, target, weight * Mat3::Identity());
 }
 
 void SpringEnergy::add_plane(const Anchor& anchor, const Vec3& point, const Vec3& normal, double weight) {
   check_weight(weight, "point-to-plane");
   const Vec3 n = unit_normal(normal);
-  add(anchor, point, weight * n * n.transpose());
+  push(anchor, point, weight * n * n.transpose());
 }
 
 void SpringEnergy::add_point_and_plane(const Anchor& anchor, const Vec3& point, const Vec3& normal, double point_weight,
@@ -50,7 +56,7 @@ void SpringEnergy::add_point_and_plane(const Anchor& anchor, const Vec3& point, 
   check_weight(point_weight, "point");
   check_weight(plane_weight, "point-to-plane");
   const Vec3 n = unit_normal(normal);
-  add(anchor, point, point_weight * Mat3::Identity() + plane_weight * n * n.transpose());
+  push(anchor, point, point_weight * Mat3::Identity() + plane_weight * n * n.transpose());
 }
 
 void SpringEnergy::clear() {

@@ -41,6 +41,7 @@ class SpringEnergy : public EnergyTerm {
   const std::vector<Vec3>& targets() const { return targets_; }
 
  private:
+  void push(const Anchor& anchor, const Vec3& target, const Mat3& stiffness);  ///< target checked, K trusted
   std::string name_;
   std::vector<Anchor> anchors_;
   std::vector<Vec3> targets_;

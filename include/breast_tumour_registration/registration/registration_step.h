@@ -29,12 +29,9 @@ struct StepContext {
   /// The model the steps simulate: the prepared one, or the stiffness step's copy.
   const RegistrationModel& model() const { return estimated_ ? *estimated_ : prepared_; }
   const RegistrationModel& prepared() const { return prepared_; }
-  /// Makes `m` (a copy of the prepared model at the estimated stiffness) the simulated model.
+  /// Makes `m` (a copy of the prepared model at the estimated stiffness) the simulated model,
+  /// and starts the positions again from its rest shape.
   void use_estimated_model(RegistrationModel m);
-  /// Sets result.x to where the deformation starts: the rest shape, stress-free, when a step
-  /// deforms (every step travels rest -> supine; from the prone shape over an unloaded rest, a
-  /// soft breast would have to swing through prone -> supine); else the prone shape.
-  void start_positions();
 
   Rigid supine_to_model = Rigid::Identity();  ///< the pose found so far
   Points targets;            ///< supine landmarks in the model frame, under supine_to_model
@@ -45,6 +42,10 @@ struct StepContext {
   const SurfaceProjector* supine();
 
  private:
+  /// Sets result.x to where the deformation starts: the rest shape, stress-free, when a step
+  /// deforms (every step travels rest -> supine; from the prone shape over an unloaded rest, a
+  /// soft breast would have to swing through prone -> supine); else the prone shape.
+  void start_positions();
   const RegistrationModel& prepared_;
   std::optional<RegistrationModel> estimated_;
   std::unique_ptr<SurfaceProjector> supine_;
