@@ -11,7 +11,8 @@ namespace btr {
 
 ForwardGravity::ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const std::vector<int>& fixed,
                                std::vector<StableNeoHookean> materials, std::vector<int> material_of,
-                               VolumeForm volume_form, double density, ForwardGravityOptions options)
+                               VolumeForm volume_form, double density, ForwardGravityOptions options,
+                               NewtonSolver* shared)
     : rest_{Points::Zero(vertices, 3), T},
       fixed_(static_cast<size_t>(vertices), false),
       materials_(std::move(materials)),
@@ -26,6 +27,14 @@ ForwardGravity::ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const
     if (v < 0 || v >= vertices) throw InputError("forward gravity: fixed vertex " + std::to_string(v) + " out of range");
     fixed_[static_cast<size_t>(v)] = true;
   }
+  if (shared) {
+    const HessianAssembler& a = shared->assembler();
+    bool same = a.num_vertices() == vertices;
+    for (Eigen::Index v = 0; same && v < vertices; ++v) same = a.is_fixed(static_cast<int>(v)) == fixed_[static_cast<size_t>(v)];
+    if (!same) throw InputError("forward gravity: the shared solver is bound to another mesh or fixed set");
+    shared->forget_factor();
+    solver_ = shared;
+  }
 }
 
 NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Points& x) {
@@ -34,9 +43,10 @@ NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Po
   add_elastic_energy(energy, rest_, materials_, material_of_, volume_form_);
   auto g = std::make_shared<GravityEnergy>(rest_, density_, gravity);
   energy.add(g);
-  if (!assembler_) {  // the pattern does not depend on the rest positions
-    assembler_ = std::make_shared<HessianAssembler>(static_cast<int>(X.rows()), rest_.T, fixed_, energy.hessian_cliques());
-    solver_ = std::make_unique<NewtonSolver>(assembler_, rest_.T);
+  if (!solver_) {  // the pattern does not depend on the rest positions
+    own_ = std::make_unique<NewtonSolver>(
+        std::make_shared<HessianAssembler>(static_cast<int>(X.rows()), rest_.T, fixed_, energy.hessian_cliques()), rest_.T);
+    solver_ = own_.get();
   }
   NewtonOptions nopt = opt_.newton;
   if (nopt.force_scale <= 0) nopt.force_scale = g->total_weight();

@@ -86,7 +86,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
     p.scene = scene_;
   }
   p.mesh_seconds = key > 0 ? p.scene.tetrahedralize_seconds : 0;
-  p.model = prepare_model(p.scene, p.warnings, unload_);
+  p.model = prepare_model(p.scene, p.warnings, unload_, &e->solvers);
   p.prepare_seconds = since(t0);
   return *entries_.emplace(key, std::move(e)).first->second;
 }

@@ -153,7 +153,8 @@ std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOpti
   return with_simulation_mesh(scene, opt.simulation_cell_size);
 }
 
-RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload) {
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload,
+                                StepSolvers* cache) {
   RegistrationModel m = make_registration_model(scene.prone, scene.chest_wall, scene.material, scene.gravity);
   for (const auto& t : scene.tumours) {
     const int outside = add_tumour(m, t.name, t.prone);
@@ -171,7 +172,7 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
   }
   // Last: it simulates with the final materials (a stiffer tumour included).
   // Its note (a stop before converging) reaches the result's warnings with the step reports.
-  if (scene.prone_gravity && !scene.youngs_modulus_range) unload_model(m, *scene.prone_gravity, unload);
+  if (scene.prone_gravity && !scene.youngs_modulus_range) unload_model(m, *scene.prone_gravity, unload, cache);
   return m;
 }
 

@@ -20,7 +20,7 @@ class StiffnessStep : public RegistrationStep {
     so.min_youngs_modulus = (*c.scene.youngs_modulus_range)[0];
     so.max_youngs_modulus = (*c.scene.youngs_modulus_range)[1];
     const StiffnessEstimate est =
-        estimate_stiffness(c.prepared(), *c.scene.prone_gravity, c.scene.landmark_anchors, c.scene.landmark_supine, so);
+        estimate_stiffness(c.prepared(), *c.scene.prone_gravity, c.scene.landmark_anchors, c.scene.landmark_supine, so, c.solvers);
     RegistrationModel m = c.prepared();
     scale_stiffness(m, est.scale);
     set_rest_shape(m, est.rest, unload_report(est.unload, c.prepared().prone));
@@ -125,7 +125,7 @@ class GravityStep : public RegistrationStep {
     auto g = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
     energy.add(g);
     StepSolvers local;  // without an engine's cache: built for this call only
-    NewtonSolver& solver = (c.solvers ? *c.solvers : local).newton("gravity", model, energy.hessian_cliques());
+    NewtonSolver& solver = (c.solvers ? *c.solvers : local).gravity(model);
     NewtonOptions nopt = c.opt.gravity;
     nopt.force_scale = g->total_weight();
     if (c.callback) nopt.callback = [&](const IterationInfo& it) { return c.callback("gravity", it); };

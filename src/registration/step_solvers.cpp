@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/registration/step_solvers.h"
 
+#include "breast_tumour_registration/fem/total_energy.h"
+
 namespace btr {
 namespace {
 
@@ -34,6 +36,12 @@ NewtonSolver& StepSolvers::newton(const std::string& key, const RegistrationMode
   ++built_;
   Pattern& stored = solvers_[key] = std::move(p);
   return *stored.solver;
+}
+
+NewtonSolver& StepSolvers::gravity(const RegistrationModel& model) {
+  TotalEnergy elastic;  // gravity adds no cliques
+  add_model_elastic_energy(elastic, model);
+  return newton("gravity", model, elastic.hessian_cliques());
 }
 
 const SkinningSubspace& StepSolvers::subspace(const RegistrationModel& model, const std::vector<int>& seeds,

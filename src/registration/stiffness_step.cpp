@@ -11,6 +11,7 @@
 #include "breast_tumour_registration/fem/forward_gravity.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
+#include "breast_tumour_registration/registration/step_solvers.h"
 #include "breast_tumour_registration/registration/unload_step.h"
 
 namespace btr {
@@ -31,7 +32,7 @@ void scale_stiffness(RegistrationModel& model, double scale) {
 
 StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3& prone_gravity,
                                      const std::vector<Anchor>& anchors, const Points& supine,
-                                     const StiffnessOptions& opt) {
+                                     const StiffnessOptions& opt, StepSolvers* cache) {
   const auto t0 = std::chrono::steady_clock::now();
   if (anchors.size() < 3 || supine.rows() != static_cast<Eigen::Index>(anchors.size()))
     throw InputError("stiffness: estimating the Young's modulus needs >= 3 landmark pairs, got " +
@@ -41,6 +42,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   const double E0 = model.material.youngs_modulus;
   const TetMesh prone{model.prone, model.rest.T};
   StiffnessEstimate est;
+  NewtonSolver* shared = cache ? &cache->gravity(model) : nullptr;
 
   // The last two candidates' (log E, unloaded shape): the next one starts from their
   // extrapolation, which saves most of the cost of a soft candidate.
@@ -54,6 +56,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     Candidate c;
     const double k = E / E0;  // the material scaled by k == the gravities divided by k
     UnloadProblem pb = unload_problem(model, prone, prone_gravity / k);
+    pb.solver = shared;
     const double u = std::log(E);
     Points guess;
     if (known.size() >= 2) {
@@ -88,7 +91,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     }
     c.rest = c.unload.rest;
     ForwardGravity phi(model.rest.T, model.prone.rows(), model.chest_wall, model.materials, model.material_of,
-                       model.volume_form, model.material.density, opt.unload.forward);
+                       model.volume_form, model.material.density, opt.unload.forward, shared);
     Points x = c.rest;
     try {
       phi.solve(c.rest, model.gravity / k, x);
@@ -191,6 +194,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   // the chosen one is finished from there, so that the unload step's "converged" holds.
   if (!c_best.unload.converged) {
     UnloadProblem pb = unload_problem(model, prone, prone_gravity / est.scale);
+    pb.solver = shared;
     pb.initial_rest = &c_best.rest;
     UnloadResult polished = estimate_unloaded_shape(pb, opt.unload);
     if (polished.converged || polished.max_mismatch < c_best.unload.max_mismatch) {

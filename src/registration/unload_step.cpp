@@ -4,6 +4,7 @@
 #include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/validation.h"
+#include "breast_tumour_registration/registration/step_solvers.h"
 
 namespace btr {
 
@@ -45,11 +46,14 @@ StepReport unload_report(const UnloadResult& u, const Points& prone) {
   return rep;
 }
 
-StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options) {
+StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options,
+                        StepSolvers* cache) {
   if (!prone_gravity.allFinite() || !(prone_gravity.norm() > 0))
     throw InputError("prone_gravity: must be a finite, non-zero vector [m/s^2]");
   const TetMesh loaded{model.prone, model.rest.T};
-  const UnloadResult u = estimate_unloaded_shape(unload_problem(model, loaded, prone_gravity), options);
+  UnloadProblem pb = unload_problem(model, loaded, prone_gravity);
+  if (cache) pb.solver = &cache->gravity(model);
+  const UnloadResult u = estimate_unloaded_shape(pb, options);
 
   StepReport rep = unload_report(u, model.prone);
   // The prone shape as rest misses the prone shape by about the sag; the estimate is kept when

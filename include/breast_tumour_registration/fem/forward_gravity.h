@@ -25,9 +25,13 @@ struct ForwardGravityOptions {
 class ForwardGravity {
  public:
   /// Throws InputError for a fixed vertex out of range or an unresolved volume form.
+  /// `shared`: a Newton solver already bound to this problem's Hessian pattern (these tets and
+  /// fixed vertices, the elastic energy's cliques), e.g. an engine's cached one, used instead of
+  /// building one, so its symbolic analysis is reused; its numeric factor is dropped first, so
+  /// the solves are those of a new solver. Null: one is built on the first solve.
   ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const std::vector<int>& fixed,
                  std::vector<StableNeoHookean> materials, std::vector<int> material_of, VolumeForm volume_form,
-                 double density, ForwardGravityOptions options = {});
+                 double density, ForwardGravityOptions options = {}, NewtonSolver* shared = nullptr);
 
   /// The equilibrium of rest shape X under `gravity` [m/s^2] with the fixed vertices at X's
   /// positions; x is the start and receives the equilibrium. Returns the Newton iterations it
@@ -48,8 +52,8 @@ class ForwardGravity {
   VolumeForm volume_form_;
   double density_;
   ForwardGravityOptions opt_;
-  std::shared_ptr<HessianAssembler> assembler_;
-  std::unique_ptr<NewtonSolver> solver_;
+  std::unique_ptr<NewtonSolver> own_;
+  NewtonSolver* solver_ = nullptr;  ///< own_, or the shared one
   int newton_iterations_ = 0, load_steps_ = 0;
 };
 

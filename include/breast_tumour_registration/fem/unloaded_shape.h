@@ -67,6 +67,8 @@ struct UnloadProblem {
   /// A first estimate of the rest shape (e.g. the unloaded shape of a nearby stiffness): the
   /// direct attempt starts from it instead of the inverse-gravity solve. Null: inverse gravity.
   const Points* initial_rest = nullptr;
+  /// A Newton solver bound to this problem's pattern to reuse (ForwardGravity's `shared`).
+  NewtonSolver* solver = nullptr;
 };
 
 /// Estimates the unloaded shape. Throws InputError for bad input and SolverError when a forward

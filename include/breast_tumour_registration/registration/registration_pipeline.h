@@ -86,8 +86,9 @@ bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt);
 /// asked, and the unloaded rest shape when the scene gives prone_gravity: model.unload, whose
 /// report every run_registration result carries; with `youngs_modulus: estimate` the unload
 /// waits for the stiffness, and runs in run_registration). `warnings` receives messages about tumour
-/// points outside the mesh.
-RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload = {});
+/// points outside the mesh. `cache`: the engine's solvers, which the unload's forward solves use.
+RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& warnings, const UnloadOptions& unload = {},
+                                StepSolvers* cache = nullptr);
 
 struct TumourResult {
   std::string name;

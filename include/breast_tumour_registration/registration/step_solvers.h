@@ -25,6 +25,9 @@ class StepSolvers {
   /// same (its symbolic analysis is kept, its numeric factor dropped), otherwise a new one.
   NewtonSolver& newton(const std::string& key, const RegistrationModel& model,
                        const std::vector<std::vector<int>>& cliques);
+  /// The solver of the model's elastic energy plus gravity (key "gravity"): the gravity step's,
+  /// and every forward gravity solve of the unload and stiffness estimates.
+  NewtonSolver& gravity(const RegistrationModel& model);
   /// The subspace of build_skinning_subspace(model.rest.V, model.volume, seeds, model.fixed, opt),
   /// cached while those inputs are unchanged.
   const SkinningSubspace& subspace(const RegistrationModel& model, const std::vector<int>& seeds,

@@ -25,6 +25,8 @@
 
 namespace btr {
 
+class StepSolvers;
+
 struct StiffnessOptions {
   double min_youngs_modulus = 150;    ///< [Pa] of the model's first material
   double max_youngs_modulus = 24000;  ///< [Pa]
@@ -50,10 +52,12 @@ struct StiffnessEstimate {
 /// Estimates the stiffness of `model` (its prone shape model.prone; its materials as the
 /// reference) from the supine landmark positions `supine` (any frame, one row per anchor).
 /// Throws InputError for fewer than 3 landmarks or a bad range; a range in which no candidate
-/// could be simulated is a SolverError.
+/// could be simulated is a SolverError. `cache`: an engine's solvers; every candidate's forward
+/// solves then share its gravity solver (one symbolic analysis for the whole search and across
+/// calls); null: each candidate builds its own.
 StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3& prone_gravity,
                                      const std::vector<Anchor>& anchors, const Points& supine,
-                                     const StiffnessOptions& options = {});
+                                     const StiffnessOptions& options = {}, StepSolvers* cache = nullptr);
 
 /// The model with every material scaled by `scale` (material.youngs_modulus too).
 void scale_stiffness(RegistrationModel& model, double scale);

@@ -9,6 +9,8 @@
 
 namespace btr {
 
+class StepSolvers;
+
 /// Estimates the unloaded shape of `model` (from model.prone, under prone_gravity in the model
 /// frame [m/s^2]) and makes it the rest shape; model.unload receives the report.
 ///
@@ -16,8 +18,10 @@ namespace btr {
 /// only when re-simulating from it reproduces the prone shape better than the prone shape as
 /// rest would (its mismatch is below the prone sag the inverse-gravity solve measured);
 /// otherwise the prone shape stays the rest shape. Either way the report says not converged,
-/// and its note says which shape was kept.
-StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options = {});
+/// and its note says which shape was kept. `cache`: an engine's solvers, whose gravity solver
+/// (its symbolic analysis) the forward solves reuse; null: they build their own.
+StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options = {},
+                        StepSolvers* cache = nullptr);
 
 /// The unload problem of `model`'s mesh, chest wall and materials for the imaged shape `loaded`
 /// (its vertices: model.prone, kept alive by the caller) under `gravity` [m/s^2].
