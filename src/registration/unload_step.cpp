@@ -39,10 +39,8 @@ StepReport unload_report(const UnloadResult& u, const Points& prone) {
   rep.iterations = u.newton_iterations;
   rep.outer_iterations = u.iterations;
   rep.seconds = u.seconds;
-  rep.unload_mismatch = u.max_mismatch;
-  rep.unload_forward_solve_equivalents = u.forward_solve_equivalents;
-  rep.unload_load_steps = u.load_steps;
-  rep.unload_rest_change = u.rest.rows() == prone.rows() ? (u.rest - prone).rowwise().norm().maxCoeff() : 0.0;
+  const double moved = u.rest.rows() == prone.rows() ? (u.rest - prone).rowwise().norm().maxCoeff() : 0.0;
+  rep.unload = {u.max_mismatch, u.forward_solve_equivalents, moved, u.load_steps};
   return rep;
 }
 
@@ -63,7 +61,7 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
   if (!better) {
     rep.note = "no unloaded shape better than the prone shape was found (" + u.stop_reason +
                "); the prone shape stays the rest shape";
-    rep.unload_rest_change = 0;
+    rep.unload.rest_change = 0;
     model.unload = rep;
     return rep;
   }

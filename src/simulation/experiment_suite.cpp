@@ -285,8 +285,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
               it = unloaded.emplace(run->method_youngs_modulus, std::make_pair(rm.rest.V, u)).first;
               say("unloaded shape for method E = " + format_value(run->method_youngs_modulus) + " Pa: " +
                   (u.converged ? "converged" : "not converged") + " (" + u.stop_reason + "), rest shape moved up to " +
-                  format_value(u.unload_rest_change * 1e3) + " mm, re-simulated prone within " +
-                  format_value(u.unload_mismatch * 1e3) + " mm, " + format_value(u.seconds) + " s" +
+                  format_value(u.unload.rest_change * 1e3) + " mm, re-simulated prone within " +
+                  format_value(u.unload.mismatch * 1e3) + " mm, " + format_value(u.seconds) + " s" +
                   (u.note.empty() ? "" : "; " + u.note));
             } else {
               set_rest_shape(rm, it->second.first, it->second.second);

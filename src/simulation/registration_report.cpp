@@ -59,11 +59,11 @@ Json step_report(const StepReport& s) {
             {"factorizations", s.factorizations},
             {"pcg_iterations", s.pcg_iterations}};
   if (s.name == "unload")
-    j["unload"] = {{"resimulated_prone_mismatch_mm", num(s.unload_mismatch * 1e3)},
-                   {"rest_shape_change_mm", num(s.unload_rest_change * 1e3)},
+    j["unload"] = {{"resimulated_prone_mismatch_mm", num(s.unload.mismatch * 1e3)},
+                   {"rest_shape_change_mm", num(s.unload.rest_change * 1e3)},
                    {"forward_solves", s.outer_iterations},
-                   {"forward_solve_equivalents", num(s.unload_forward_solve_equivalents)},
-                   {"load_steps", s.unload_load_steps},
+                   {"forward_solve_equivalents", num(s.unload.forward_solve_equivalents)},
+                   {"load_steps", s.unload.load_steps},
                    {"note", s.note}};
   return j;
 }

@@ -129,7 +129,7 @@ int main(int argc, char** argv) {
                   s.outer_iterations ? (", " + std::to_string(s.outer_iterations) + outer).c_str() : "", s.seconds);
       if (s.name == "unload")
         std::printf("[%-8s]   rest shape moved up to %.2f mm from the prone shape; re-simulated prone within %.4f mm\n",
-                    s.name.c_str(), s.unload_rest_change * 1e3, s.unload_mismatch * 1e3);
+                    s.name.c_str(), s.unload.rest_change * 1e3, s.unload.mismatch * 1e3);
       if (s.name == "unload") continue;  // its solves are not profiled step by step
       std::printf("[%-8s]   setup %.3f, assembly %.3f, factorization %.3f (%d), solve %.3f (%d PCG iterations), "
                   "line search %.3f, projection %.3f s\n",

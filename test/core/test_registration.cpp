@@ -330,11 +330,11 @@ TEST(Unload, InThePipelineItBeatsTheProneShapeAsRestOnASoftBreast) {
     const StepReport& u = unloaded.reports.front();
     EXPECT_EQ(u.name, "unload");
     EXPECT_TRUE(u.converged) << u.stop_reason;
-    EXPECT_LT(u.unload_mismatch, 1e-4);
-    EXPECT_GT(u.unload_rest_change, 0.005);
+    EXPECT_LT(u.unload.mismatch, 1e-4);
+    EXPECT_GT(u.unload.rest_change, 0.005);
     std::printf("600 Pa phantom, %s: worst tumour %.3f mm with the prone shape as rest, %.3f mm unloaded (rest moved "
                 "%.1f mm, %d forward solves, %.2f s)\n",
-                name.c_str(), worst_error(prone) * 1e3, worst_error(unloaded) * 1e3, u.unload_rest_change * 1e3,
+                name.c_str(), worst_error(prone) * 1e3, worst_error(unloaded) * 1e3, u.unload.rest_change * 1e3,
                 u.outer_iterations, u.seconds);
     EXPECT_LT(worst_error(unloaded), worst_error(prone));
     if (name == "full") {

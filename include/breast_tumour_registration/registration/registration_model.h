@@ -48,10 +48,12 @@ struct StepReport {
   /// surface projections; with the number of factorizations and PCG iterations.
   double t_setup = 0, t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0, t_projection = 0;
   int factorizations = 0, pcg_iterations = 0;
-  /// unload step: max |phi(rest) - prone| [m], its cost in forward-solve equivalents, the
-  /// load-continuation fractions it needed, and how far the rest shape moved from the prone one [m]
-  double unload_mismatch = 0, unload_forward_solve_equivalents = 0, unload_rest_change = 0;
-  int unload_load_steps = 0;
+  /// unload step: max |phi(rest) - prone| [m], its cost in forward-solve equivalents, how far
+  /// the rest shape moved from the prone one [m] and the load-continuation fractions it needed
+  struct UnloadFigures {
+    double mismatch = 0, forward_solve_equivalents = 0, rest_change = 0;
+    int load_steps = 0;
+  } unload;
   /// stiffness step: the estimated Young's modulus [Pa] and the landmark misfit of its gravity-only prediction [m]
   double stiffness_youngs_modulus = 0, stiffness_misfit = 0;
   long inverted = 0;                ///< inverted tetrahedra at the end of the step
