@@ -148,6 +148,10 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
   std::mt19937 rng(seed);
   std::normal_distribution<double> z(0.0, 1.0);
   std::vector<std::vector<Vec3>> centroids(model.tumours.size());
+  // Per tumour and vertex: the distance of the sampled vertex to its nominal position.
+  std::vector<std::vector<std::vector<double>>> vertex_distances(model.tumours.size());
+  for (size_t i = 0; i < nominal.tumours.size(); ++i)
+    vertex_distances[i].resize(static_cast<size_t>(nominal.tumours[i].registered.V.rows()));
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < samples; ++k) {
     // Every draw is made whether or not its source is used, so a seed gives the same inputs.
@@ -165,7 +169,14 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
       const RegistrationResult r = run_registration(s, m, o, {}, &e.solvers);
       ++out.samples;
       if (!r.converged) ++out.not_converged;
-      for (size_t i = 0; i < r.tumours.size(); ++i) centroids[i].push_back(r.tumours[i].centroid);
+      for (size_t i = 0; i < r.tumours.size(); ++i) {
+        centroids[i].push_back(r.tumours[i].centroid);
+        const Points& V = r.tumours[i].registered.V;
+        const Points& V0 = nominal.tumours[i].registered.V;
+        if (V.rows() == V0.rows())  // the same embedding: vertex for vertex
+          for (Eigen::Index v = 0; v < V.rows(); ++v)
+            vertex_distances[i][static_cast<size_t>(v)].push_back((V.row(v) - V0.row(v)).norm());
+      }
     } catch (const std::exception&) {
       ++out.failed;
     }
@@ -184,6 +195,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
       }
       t.mean_shift = mean - nominal.tumours[i].centroid;
       t.radius_95 = percentile_95(d);
+      for (auto& dv : vertex_distances[i]) t.vertex_radius_95.push_back(percentile_95(std::move(dv)));
     }
     out.tumours.push_back(t);
   }

@@ -9,6 +9,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/confidence_ellipsoid.h"
+#include "breast_tumour_registration/geometry/margin_shell.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/io/cross_section_image.h"
@@ -95,6 +96,11 @@ Json tumour_report(const TumourResult& t, const SampledUncertainty* sampled, siz
     const auto& u = sampled->tumours[i];
     j["uncertainty_sampled"] = {
         {"radius_95_mm", num(u.radius_95 * 1e3)}, {"covariance_mm2", mat(u.covariance, 1e6)}, {"mean_shift_mm", vec_mm(u.mean_shift)}};
+    if (!u.vertex_radius_95.empty()) {
+      std::vector<double> m = u.vertex_radius_95;
+      std::sort(m.begin(), m.end());
+      j["uncertainty_sampled"]["margin_95_mm"] = {{"median", num(m[m.size() / 2] * 1e3)}, {"max", num(m.back() * 1e3)}};
+    }
   }
   return j;
 }
@@ -218,9 +224,15 @@ std::vector<std::string> write_registration_outputs(const std::string& dir, cons
   const SurfaceMesh skin = boundary_surface(deformed);
   write_surface(path("registered_surface.obj"), skin, scene.units);
   write_surface(path("registered_surface.ply"), skin, scene.units);
-  for (const auto& t : r.tumours) {
+  for (size_t i = 0; i < r.tumours.size(); ++i) {
+    const TumourResult& t = r.tumours[i];
     write_surface(path("tumour_" + t.name + "_registered.obj"), t.registered, scene.units);
     write_surface(path("tumour_" + t.name + "_registered.ply"), t.registered, scene.units);
+    // The margin shell: the surface grown by each vertex's sampled 95 % displacement bound.
+    if (r.sampled_uncertainty && i < r.sampled_uncertainty->tumours.size() &&
+        r.sampled_uncertainty->tumours[i].vertex_radius_95.size() == static_cast<size_t>(t.registered.V.rows()))
+      write_surface(path("tumour_" + t.name + "_margin95.obj"),
+                    margin_shell(t.registered, r.sampled_uncertainty->tumours[i].vertex_radius_95), scene.units);
   }
   std::ofstream(path("report.json")) << registration_report_json(scene, model, r, prepare_seconds);
   // For 3D Slicer, when the scene says its patient frame: LPS millimetres (Slicer's file

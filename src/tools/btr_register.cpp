@@ -161,9 +161,12 @@ int main(int argc, char** argv) {
     if (r.sampled_uncertainty) {
       const SampledUncertainty& su = *r.sampled_uncertainty;
       for (size_t i = 0; i < su.tumours.size() && i < r.tumours.size(); ++i)
-        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm), mean shift %.2f mm%s\n", r.tumours[i].name.c_str(),
-                    su.tumours[i].radius_95 * 1e3, r.tumours[i].uncertainty ? r.tumours[i].uncertainty->radius_95 * 1e3 : 0.0,
-                    su.tumours[i].mean_shift.norm() * 1e3,
+        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm), mean shift %.2f mm, margin shell up to %.2f mm%s\n",
+                    r.tumours[i].name.c_str(), su.tumours[i].radius_95 * 1e3,
+                    r.tumours[i].uncertainty ? r.tumours[i].uncertainty->radius_95 * 1e3 : 0.0, su.tumours[i].mean_shift.norm() * 1e3,
+                    su.tumours[i].vertex_radius_95.empty()
+                        ? 0.0
+                        : *std::max_element(su.tumours[i].vertex_radius_95.begin(), su.tumours[i].vertex_radius_95.end()) * 1e3,
                     r.tumours[i].has_ground_truth ? (r.tumours[i].centroid_distance <= su.tumours[i].radius_95
                                                          ? "; holds the true centroid"
                                                          : "; the true centroid lies outside")

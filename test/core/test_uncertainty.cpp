@@ -1,17 +1,22 @@
 // Where the tumour may be (issue 14): the linearised centroid uncertainty against full re-solves.
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/margin_shell.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "test_util.h"
 
 using namespace btr;
@@ -184,6 +189,36 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
     EXPECT_GT(a.tumours[i].radius_95, 0.0);
     EXPECT_GT(a.tumours[i].covariance.trace(), 0.0);
   }
+  // The per-vertex bound of the margin shell: one per tumour vertex, the same seed the same
+  // values; a vertex moves at least as far as the centroid does in some sample, so the largest
+  // vertex bound is not below the smallest sampled centroid distance (here: > 0).
+  for (size_t i = 0; i < a.tumours.size(); ++i) {
+    ASSERT_EQ(a.tumours[i].vertex_radius_95.size(), static_cast<size_t>(nominal.tumours[i].registered.V.rows()));
+    EXPECT_EQ(a.tumours[i].vertex_radius_95, b.tumours[i].vertex_radius_95);
+    const double most = *std::max_element(a.tumours[i].vertex_radius_95.begin(), a.tumours[i].vertex_radius_95.end());
+    EXPECT_GT(most, 0.0);
+    EXPECT_LT(most, 0.02);  // metres: a bound of centimetres on the coarse phantom would be a unit slip
+  }
+  // The outputs: each tumour's margin shell, its vertices that far from the registered ones,
+  // and the report's figures.
+  {
+    RegistrationResult with = nominal;
+    with.sampled_uncertainty = a;
+    const PreparedScene& prep = engine.prepare(o);
+    const std::string d = btr::test::temp_dir();
+    write_registration_outputs(d, prep.scene, prep.model, with, 0);
+    std::ifstream report(d + "/report.json");
+    const nlohmann::json j = nlohmann::json::parse(report);
+    for (size_t i = 0; i < a.tumours.size(); ++i) {
+      const TumourResult& t = nominal.tumours[i];
+      const SurfaceMesh shell = read_surface(d + "/tumour_" + t.name + "_margin95.obj", prep.scene.units);
+      ASSERT_EQ(shell.V.rows(), t.registered.V.rows());
+      for (Eigen::Index v = 0; v < shell.V.rows(); ++v)
+        EXPECT_NEAR((shell.V.row(v) - t.registered.V.row(v)).norm(), a.tumours[i].vertex_radius_95[static_cast<size_t>(v)], 1e-6);
+      const double most = *std::max_element(a.tumours[i].vertex_radius_95.begin(), a.tumours[i].vertex_radius_95.end());
+      EXPECT_NEAR(j.at("tumours")[i].at("uncertainty_sampled").at("margin_95_mm").at("max").get<double>(), most * 1e3, 1e-9);
+    }
+  }
   // No source: every sample is the nominal registration.
   UncertaintyOptions none;
   none.youngs_modulus_log_sd = none.gravity_direction_deg = none.depth_noise = 0;
@@ -191,10 +226,39 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
   for (const auto& t : z.tumours) {
     EXPECT_LT(t.radius_95, 1e-12);
     EXPECT_LT(t.covariance.norm(), 1e-20);
+    for (double r : t.vertex_radius_95) EXPECT_LT(r, 1e-12);
   }
   expect_throw_with<InputError>([&] { engine.sample_uncertainty(o, u, 1, 3, nominal); }, "at least 2 samples");
   EXPECT_EQ(percentile_95({3, 1, 2}), 3.0);
   EXPECT_EQ(percentile_95({}), 0.0);
+}
+
+TEST(MarginShell, GrowsASphereOutwardsByTheBoundAtEveryVertexWhateverItsOrientation) {
+  const Vec3 c(0.01, -0.02, 0.03);
+  const double R = 0.01;
+  SurfaceMesh sphere = make_icosphere(c, R, 3);
+  std::vector<double> grow(static_cast<size_t>(sphere.V.rows()));
+  for (Eigen::Index v = 0; v < sphere.V.rows(); ++v) grow[static_cast<size_t>(v)] = 0.001 + 0.002 * (sphere.V(v, 2) > c.z());
+  SurfaceMesh inward = sphere;
+  inward.F.col(1).swap(inward.F.col(2));
+  for (const SurfaceMesh* s : {&sphere, &inward}) {
+    const SurfaceMesh shell = margin_shell(*s, grow);
+    ASSERT_EQ(shell.F, s->F);
+    for (Eigen::Index v = 0; v < shell.V.rows(); ++v) {
+      const double want = R + grow[static_cast<size_t>(v)];
+      EXPECT_NEAR((shell.V.row(v).transpose() - c).norm(), want, 1e-3 * want) << v;  // vertex normals of an icosphere are radial
+    }
+    EXPECT_GT(std::abs(enclosed_volume(shell)), std::abs(enclosed_volume(*s)));
+  }
+  EXPECT_EQ(margin_shell(sphere, std::vector<double>(grow.size(), 0.0)).V, sphere.V);
+  expect_throw_with<InputError>([&] { margin_shell(sphere, {0.001}); }, "grow values for");
+  grow[3] = -1e-3;
+  expect_throw_with<InputError>([&] { margin_shell(sphere, grow); }, ">= 0");
+  grow[3] = std::nan("");
+  expect_throw_with<InputError>([&] { margin_shell(sphere, grow); }, "finite");
+  SurfaceMesh open = sphere;
+  open.F.conservativeResize(1, 3);
+  expect_throw_with<InputError>([&] { margin_shell(open, std::vector<double>(grow.size(), 0.0)); }, "margin shell");
 }
 
 TEST(UncertaintyPicture, TheRegionDrawnIsTheCovariances95PercentEllipsoid) {

@@ -102,6 +102,9 @@ struct SampledUncertainty {
     Mat3 covariance = Mat3::Zero();  ///< of the sampled centroids about their mean, supine frame [m^2]
     double radius_95 = 0;            ///< [m] the 95th percentile of the distance to the nominal centroid
     Vec3 mean_shift = Vec3::Zero();  ///< sample mean minus the nominal centroid [m]
+    /// Per vertex of the registered tumour surface: the 95th percentile of its distance to the
+    /// nominal position over the samples [m] (the margin shell grows the surface by it).
+    std::vector<double> vertex_radius_95;
   };
   std::vector<Tumour> tumours;
   int samples = 0;        ///< registrations that finished
