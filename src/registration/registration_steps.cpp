@@ -125,7 +125,7 @@ class GravityStep : public RegistrationStep {
     auto g = std::make_shared<GravityEnergy>(model.rest, model.material.density, model.gravity);
     energy.add(g);
     StepSolvers local;  // without an engine's cache: built for this call only
-    NewtonSolver& solver = (c.solvers ? *c.solvers : local).gravity(model);
+    NewtonSolver& solver = (c.solvers ? *c.solvers : local).gravity(model, energy.hessian_cliques());
     NewtonOptions nopt = c.opt.gravity;
     nopt.force_scale = g->total_weight();
     if (c.callback) nopt.callback = [&](const IterationInfo& it) { return c.callback("gravity", it); };

@@ -41,7 +41,11 @@ NewtonSolver& StepSolvers::newton(const std::string& key, const RegistrationMode
 NewtonSolver& StepSolvers::gravity(const RegistrationModel& model) {
   TotalEnergy elastic;  // gravity adds no cliques
   add_model_elastic_energy(elastic, model);
-  return newton("gravity", model, elastic.hessian_cliques());
+  return gravity(model, elastic.hessian_cliques());
+}
+
+NewtonSolver& StepSolvers::gravity(const RegistrationModel& model, const std::vector<std::vector<int>>& cliques) {
+  return newton("gravity", model, cliques);
 }
 
 const SkinningSubspace& StepSolvers::subspace(const RegistrationModel& model, const std::vector<int>& seeds,

@@ -190,8 +190,7 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
     EXPECT_GT(a.tumours[i].covariance.trace(), 0.0);
   }
   // The per-vertex bound of the margin shell: one per tumour vertex, the same seed the same
-  // values; a vertex moves at least as far as the centroid does in some sample, so the largest
-  // vertex bound is not below the smallest sampled centroid distance (here: > 0).
+  // values, some spread where the sources move the tumour, and millimetres, not centimetres.
   for (size_t i = 0; i < a.tumours.size(); ++i) {
     ASSERT_EQ(a.tumours[i].vertex_radius_95.size(), static_cast<size_t>(nominal.tumours[i].registered.V.rows()));
     EXPECT_EQ(a.tumours[i].vertex_radius_95, b.tumours[i].vertex_radius_95);

@@ -28,6 +28,8 @@ class StepSolvers {
   /// The solver of the model's elastic energy plus gravity (key "gravity"): the gravity step's,
   /// and every forward gravity solve of the unload and stiffness estimates.
   NewtonSolver& gravity(const RegistrationModel& model);
+  /// The same, for a caller that has built that energy already: `cliques` are its Hessian cliques.
+  NewtonSolver& gravity(const RegistrationModel& model, const std::vector<std::vector<int>>& cliques);
   /// The subspace of build_skinning_subspace(model.rest.V, model.volume, seeds, model.fixed, opt),
   /// cached while those inputs are unchanged.
   const SkinningSubspace& subspace(const RegistrationModel& model, const std::vector<int>& seeds,
