@@ -26,8 +26,19 @@ double sq(double v) { return v * v; }
 
 void scale_stiffness(RegistrationModel& model, double scale) {
   if (!(scale > 0) || !std::isfinite(scale)) throw InputError("stiffness: the scale must be positive");
-  for (auto& m : model.materials) m = StableNeoHookean::from_lame(m.mu() * scale, m.lambda() * scale);
+  // lambda() is the SNH volume stiffness lambda_L + mu; from_lame takes the classical lambda_L.
+  for (auto& m : model.materials) m = StableNeoHookean::from_lame(m.mu() * scale, (m.lambda() - m.mu()) * scale);
   model.material.youngs_modulus *= scale;
+}
+
+void set_poisson_ratio(RegistrationModel& model, double nu) {
+  if (!(nu >= 0 && nu < 0.5)) throw InputError("Poisson's ratio must be in [0, 0.5), got " + std::to_string(nu));
+  for (auto& m : model.materials) {
+    const double mu = m.mu(), lambda_l = m.lambda() - mu;
+    const double youngs = mu * (3 * lambda_l + 2 * mu) / (lambda_l + mu);
+    m = StableNeoHookean(youngs, nu);
+  }
+  model.material.poisson_ratio = nu;
 }
 
 StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3& prone_gravity,

@@ -11,6 +11,7 @@
 #include "breast_tumour_registration/registration/material_regions.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
+#include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 #include "test_util.h"
@@ -165,4 +166,29 @@ TEST(MaterialRegions, AnEstimatedStiffnessScalesEveryRegion) {
   const double gland_E = j.at("materials")[1].at("youngs_modulus_Pa").get<double>();
   EXPECT_NEAR(gland_E / r.estimated_youngs_modulus, 2.0, 1e-9);
   EXPECT_DOUBLE_EQ(j.at("stiffness").at("estimated_youngs_modulus_Pa").get<double>(), r.estimated_youngs_modulus);
+}
+
+// The uncertainty sampling and the stiffness search edit a prepared model's materials: scaling
+// keeps Poisson's ratio (it used to add one shear modulus to the volume stiffness per call,
+// because lambda() is the SNH lambda_L + mu and from_lame takes lambda_L), and a new Poisson's
+// ratio keeps each material's Young's modulus.
+TEST(MaterialRegions, ScalingKeepsPoissonsRatioAndANewRatioKeepsYoungsModulus) {
+  RegistrationModel m;
+  m.materials = {StableNeoHookean(1000, 0.49), StableNeoHookean(5000, 0.49)};
+  m.material.youngs_modulus = 1000;
+  auto expect_material = [](const StableNeoHookean& got, double e, double nu) {
+    const StableNeoHookean want(e, nu);
+    EXPECT_NEAR(got.mu(), want.mu(), 1e-9 * want.mu());
+    EXPECT_NEAR(got.lambda(), want.lambda(), 1e-9 * want.lambda());
+  };
+  scale_stiffness(m, 3);
+  scale_stiffness(m, 1);  // the identity, however often
+  expect_material(m.materials[0], 3000, 0.49);
+  expect_material(m.materials[1], 15000, 0.49);
+  EXPECT_DOUBLE_EQ(m.material.youngs_modulus, 3000);
+  set_poisson_ratio(m, 0.45);
+  expect_material(m.materials[0], 3000, 0.45);
+  expect_material(m.materials[1], 15000, 0.45);
+  EXPECT_DOUBLE_EQ(m.material.poisson_ratio, 0.45);
+  expect_throw_with<InputError>([&] { set_poisson_ratio(m, 0.5); }, "Poisson's ratio");
 }

@@ -61,5 +61,9 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
 
 /// The model with every material scaled by `scale` (material.youngs_modulus too).
 void scale_stiffness(RegistrationModel& model, double scale);
+/// The model with every material's Poisson's ratio set to `nu`, each keeping its Young's
+/// modulus (material.poisson_ratio too); InputError outside [0, 0.5). The volume form stays as
+/// prepared.
+void set_poisson_ratio(RegistrationModel& model, double nu);
 
 }  // namespace btr
