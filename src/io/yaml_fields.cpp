@@ -28,12 +28,19 @@ std::string leaf(const std::string& path) {
 std::string suggestion(const std::string& path, const std::vector<std::string>& valid) {
   for (const auto& v : valid)
     if (v.find('*') == std::string::npos && leaf(v) == leaf(path)) return v;
+  // A key beside it that only adds a unit ("uncertainty.landmark_sd" for landmark_sd_mm).
+  const auto parent = [](const std::string& p) { return p.substr(0, p.size() - leaf(p).size()); };
+  for (const auto& v : valid)
+    if (v.find('*') == std::string::npos && parent(v) == parent(path) && leaf(v).rfind(leaf(path) + "_", 0) == 0) return v;
+  // Else the closest spelling; ties go to a key beside the unknown one.
   std::string best;
   std::size_t best_d = 4;
+  bool best_beside = false;
   for (const auto& v : valid) {
     if (v.find('*') != std::string::npos) continue;
     const std::size_t d = std::min(edit_distance(path, v), edit_distance(leaf(path), leaf(v)));
-    if (d < best_d) best = v, best_d = d;
+    const bool beside = parent(v) == parent(path);
+    if (d < best_d || (d == best_d && beside && !best_beside)) best = v, best_d = d, best_beside = beside;
   }
   return best;
 }
