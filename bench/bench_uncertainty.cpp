@@ -75,18 +75,27 @@ int main(int argc, char** argv) {
                 100 * r.uncertainty_seconds / r.seconds);
     if (sampling > 0) {
       RegistrationEngine engine(scene);
-      const UncertaintyOptions all = o.uncertainty;
+      // The sources the linearisation covers, with E log-uniform about the scene's nominal
+      // modulus (over a factor of 15, as the default 200 to 3000 Pa), so that the two forms
+      // propagate the same distribution: landmarks and Poisson's ratio held.
+      UncertaintyOptions all = o.uncertainty;
+      const double e0 = scene.material.youngs_modulus;
+      all.sources.youngs_modulus_range = {e0 / std::sqrt(15.0), e0 * std::sqrt(15.0)};
+      all.sources.poisson_ratio_range = {0, 0};
+      all.sources.landmark_sd = 0;
       struct Source {
         const char* name;
         UncertaintyOptions u;
       };
       std::vector<Source> sources(4, {"", all});
       sources[0].name = "youngs_modulus";
-      sources[0].u.gravity_direction_deg = sources[0].u.depth_noise = 0;
+      sources[0].u.sources.gravity_direction_deg = sources[0].u.sources.depth_noise = 0;
       sources[1].name = "gravity_direction";
-      sources[1].u.youngs_modulus_log_sd = sources[1].u.depth_noise = 0;
+      sources[1].u.sources.youngs_modulus_range = {0, 0};
+      sources[1].u.sources.depth_noise = 0;
       sources[2].name = "depth_noise";
-      sources[2].u.youngs_modulus_log_sd = sources[2].u.gravity_direction_deg = 0;
+      sources[2].u.sources.youngs_modulus_range = {0, 0};
+      sources[2].u.sources.gravity_direction_deg = 0;
       sources[3].name = "all";
       for (Source& src : sources) {
         RegistrationOptions oo = o;

@@ -47,7 +47,8 @@ const std::vector<std::string> kSceneKeys = {
     "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "regions", "regions[]",
     "regions[].name", "regions[].youngs_modulus", "regions[].relative_stiffness", "regions[].label", "regions[].surface", "prone.cell_labels", "tumour_material",
     "tumour_material.youngs_modulus", "gravity", "prone_gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
-    "misalignment.translation_mm", "generator.*"};
+    "misalignment.translation_mm", "uncertainty", "uncertainty.youngs_modulus_range", "uncertainty.poisson_ratio_range",
+    "uncertainty.gravity_direction_deg", "uncertainty.landmark_sd_mm", "uncertainty.depth_noise_mm", "generator.*"};
 
 Scene load_scene_fields(const std::string& path);
 }  // namespace
@@ -372,6 +373,21 @@ Scene load_scene_fields(const std::string& path) {
     } else {
       c.fail("steps", "expected 'auto' or a list of steps");
     }
+  }
+  if (const YAML::Node u = root["uncertainty"]) {  // uncertainty_sources.h: the defaults unless given
+    if (!u.IsMap()) c.fail("uncertainty", "expected a mapping of the uncertain inputs' distributions");
+    auto range = [&](const char* key, std::array<double, 2>& r) {
+      const std::string f = std::string("uncertainty.") + key;
+      if (!u[key]) return;
+      if (!u[key].IsSequence() || u[key].size() != 2) c.fail(f, "expected [min, max] ([0, 0]: held)");
+      r = {c.number(u[key][0], f), c.number(u[key][1], f)};
+    };
+    range("youngs_modulus_range", s.uncertainty.youngs_modulus_range);
+    range("poisson_ratio_range", s.uncertainty.poisson_ratio_range);
+    if (u["gravity_direction_deg"]) s.uncertainty.gravity_direction_deg = c.number(u["gravity_direction_deg"], "uncertainty.gravity_direction_deg");
+    if (u["landmark_sd_mm"]) s.uncertainty.landmark_sd = 1e-3 * c.number(u["landmark_sd_mm"], "uncertainty.landmark_sd_mm");
+    if (u["depth_noise_mm"]) s.uncertainty.depth_noise = 1e-3 * c.number(u["depth_noise_mm"], "uncertainty.depth_noise_mm");
+    c.load("uncertainty", [&] { validate_uncertainty_sources(s.uncertainty); return 0; });
   }
   if (root["preset"]) s.preset = c.text(root["preset"], "preset");
   if (s.preset != "fast" && s.preset != "balanced" && s.preset != "accurate")

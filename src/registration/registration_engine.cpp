@@ -134,11 +134,17 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
     throw InputError("uncertainty sampling: the nominal result has another tumour count than the prepared model");
   SampledUncertainty out;
   std::vector<std::string> notes;
-  const bool sample_e = sources.youngs_modulus_log_sd > 0 && !model.unload;
-  if (sources.youngs_modulus_log_sd > 0 && model.unload)
+  const UncertaintySources& src = sources.sources;
+  // E is drawn over an absolute range: the unloaded rest shape depends on it (one unload per
+  // sample is not done), and a stiffness step sets it from the landmarks in every sample.
+  const bool estimates_e = e.prepared.scene.youngs_modulus_range.has_value();
+  const bool sample_e = src.samples_youngs_modulus() && !model.unload && !estimates_e;
+  if (src.samples_youngs_modulus() && model.unload && !estimates_e)
     notes.push_back("E not sampled: the unloaded rest shape depends on it (one unload per sample is not done)");
-  const bool sample_noise = sources.depth_noise > 0 && e.prepared.scene.supine_surface;
-  if (sources.depth_noise > 0 && !e.prepared.scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
+  if (src.samples_youngs_modulus() && estimates_e)
+    notes.push_back("E not sampled: the stiffness step estimates it from the (sampled) landmarks in every sample");
+  const bool sample_noise = src.depth_noise > 0 && e.prepared.scene.supine_surface;
+  if (src.depth_noise > 0 && !e.prepared.scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
   Points normals;
   if (sample_noise) normals = vertex_normals(*e.prepared.scene.supine_surface);
   const Vec3 down = model.gravity.normalized();
@@ -147,6 +153,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
   o.uncertainty.enabled = false;
   std::mt19937 rng(seed);
   std::normal_distribution<double> z(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<std::vector<Vec3>> centroids(model.tumours.size());
   // Per tumour and vertex: the distance of the sampled vertex to its nominal position.
   std::vector<std::vector<std::vector<double>>> vertex_distances(model.tumours.size());
@@ -155,16 +162,23 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < samples; ++k) {
     // Every draw is made whether or not its source is used, so a seed gives the same inputs.
-    const double log_e = sources.youngs_modulus_log_sd * z(rng);
-    const double tilt[2] = {sources.gravity_direction_deg * M_PI / 180 * z(rng), sources.gravity_direction_deg * M_PI / 180 * z(rng)};
+    const auto& er = src.youngs_modulus_range;
+    const double u_e = unit(rng);
+    const double youngs = er[0] > 0 ? er[0] * std::pow(er[1] / er[0], u_e) : 0.0;
+    const auto& nr = src.poisson_ratio_range;
+    const double nu = nr[0] + (nr[1] - nr[0]) * unit(rng);
+    const double tilt[2] = {src.gravity_direction_deg * M_PI / 180 * z(rng), src.gravity_direction_deg * M_PI / 180 * z(rng)};
     RegistrationModel m = model;
-    if (sample_e) scale_stiffness(m, std::exp(log_e));
+    if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);
+    if (src.samples_poisson_ratio()) set_poisson_ratio(m, nu);
     m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
     Scene s = e.prepared.scene;
     s.preset = opt.preset;
+    for (Eigen::Index l = 0; l < s.landmark_supine.rows(); ++l)
+      for (int c = 0; c < 3; ++c) s.landmark_supine(l, c) += src.landmark_sd * z(rng);
     if (sample_noise)
       for (Eigen::Index v = 0; v < s.supine_surface->V.rows(); ++v)
-        s.supine_surface->V.row(v) += sources.depth_noise * z(rng) * normals.row(v);
+        s.supine_surface->V.row(v) += src.depth_noise * z(rng) * normals.row(v);
     try {
       const RegistrationResult r = run_registration(s, m, o, {}, &e.solvers);
       ++out.samples;
@@ -195,6 +209,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
       }
       t.mean_shift = mean - nominal.tumours[i].centroid;
       t.radius_95 = percentile_95(d);
+      t.centroids = c;
       for (auto& dv : vertex_distances[i]) t.vertex_radius_95.push_back(percentile_95(std::move(dv)));
     }
     out.tumours.push_back(t);

@@ -18,11 +18,6 @@
 namespace btr {
 namespace {
 
-void check(double v, const char* field) {
-  if (!std::isfinite(v) || v < 0)
-    throw InputError(std::string("uncertainty: field '") + field + "' must be finite and >= 0, got " + std::to_string(v));
-}
-
 /// P(sum_i l_i z_i^2 <= r^2) for independent standard normal z, l sorted ascending.
 double chi_square_mixture_cdf(const Vec3& l, double r) {
   if (l(2) <= 0) return r >= 0 ? 1.0 : 0.0;
@@ -51,10 +46,11 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
 
 }  // namespace
 
-void validate_uncertainty_options(const UncertaintyOptions& o) {
-  check(o.youngs_modulus_log_sd, "youngs_modulus_log_sd");
-  check(o.gravity_direction_deg, "gravity_direction_deg");
-  check(o.depth_noise, "depth_noise_mm");
+void validate_uncertainty_options(const UncertaintyOptions& o) { validate_uncertainty_sources(o.sources); }
+
+double probability_within(const Mat3& covariance, double r) {
+  Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (covariance + covariance.transpose()));
+  return chi_square_mixture_cdf(es.eigenvalues().cwiseMax(0.0), r);
 }
 
 double percentile_95(std::vector<double> d) {
@@ -148,7 +144,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     }
   }
   const Mat3 R_s = model_to_supine.linear();
-  const double sd_theta = opt.gravity_direction_deg * M_PI / 180.0;
+  const double sd_theta = opt.sources.gravity_direction_deg * M_PI / 180.0;
   for (const auto& mt : model.tumours) {
     const SurfaceMesh s{apply_embedding(mt.embedding, model.rest.T, x), mt.prone.F};
     const Eigen::MatrixXd Jp = volume_centroid_jacobian(s);  // 3 x 3#P, model frame
@@ -163,7 +159,8 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     const Eigen::MatrixXd lambda = llt.solve(R);  // free DOFs x 3
     TumourUncertainty u;
     u.d_log_youngs_modulus = R_s * Vec3(-lambda.transpose() * b_E);
-    Mat3 cov_E = opt.youngs_modulus_log_sd * opt.youngs_modulus_log_sd * u.d_log_youngs_modulus *
+    const double sd_log_e = opt.sources.youngs_modulus_log_sd();
+    Mat3 cov_E = sd_log_e * sd_log_e * u.d_log_youngs_modulus *
                  u.d_log_youngs_modulus.transpose();
     Mat3 cov_g = Mat3::Zero();
     if (gravity)
@@ -177,7 +174,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       const int f = H.free_index(h.vertex);
       if (f < 0) continue;
       const Vec3 d = R_s * Vec3(spring * lambda.middleRows<3>(3 * f).transpose() * h.normal);
-      cov_d += opt.depth_noise * opt.depth_noise * d * d.transpose();
+      cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
     }
     u.covariance = cov_E + cov_g + cov_d;
     u.sources = {{"youngs_modulus", cov_E}, {"gravity_direction", cov_g}, {"depth_noise", cov_d}};

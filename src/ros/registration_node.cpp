@@ -270,6 +270,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     if (req.uncertainty != "" && req.uncertainty != "none" && req.uncertainty != "linear")
       throw InputError("request field 'uncertainty': '" + req.uncertainty + "' is not one of \"\", none, linear");
     opt.uncertainty.enabled = req.uncertainty == "linear";
+    opt.uncertainty.sources = engine_->scene().uncertainty;
     std::optional<LiveScan> scan;
     LiveSceneOptions lo;
     if (req.use_latest_cloud) {

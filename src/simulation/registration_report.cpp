@@ -176,6 +176,14 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                                 {"failed", r.sampled_uncertainty->failed},
                                 {"seconds_per_sample", num(r.sampled_uncertainty->seconds_per_sample)},
                                 {"note", r.sampled_uncertainty->note}};
+  if (j.contains("uncertainty") || j.contains("uncertainty_sampled")) {  // the distributions propagated
+    const UncertaintySources& u = scene.uncertainty;
+    j["uncertainty_sources"] = {{"youngs_modulus_range_Pa", {num(u.youngs_modulus_range[0]), num(u.youngs_modulus_range[1])}},
+                                {"poisson_ratio_range", {num(u.poisson_ratio_range[0]), num(u.poisson_ratio_range[1])}},
+                                {"gravity_direction_deg", num(u.gravity_direction_deg)},
+                                {"landmark_sd_mm", num(u.landmark_sd * 1e3)},
+                                {"depth_noise_mm", num(u.depth_noise * 1e3)}};
+  }
   j["landmark_residual_mm"] = {{"mean", num(r.landmark_residual_mean * 1e3)}, {"max", num(r.landmark_residual_max * 1e3)}};
   j["skin_to_supine_surface_mm"] = {{"mean", num(r.skin_distance_mean * 1e3)}, {"max", num(r.skin_distance_max * 1e3)}};
   j["warnings"] = r.warnings;

@@ -43,7 +43,9 @@ int main(int argc, char** argv) {
   app.add_option("--uncertainty", uncertainty,
                  "none; linear (experimental, not yet validated): each tumour centroid's covariance and 95 % radius "
                  "from the Young's modulus, the gravity direction and the depth noise (tumour_uncertainty.h); sampling: "
-                 "the same from re-registrations with sampled inputs, beside the linear figures")
+                 "the same from re-registrations with every source sampled (Young's modulus, Poisson's ratio, gravity "
+                 "direction, landmarks, depth noise), beside the linear figures. The distributions are the scene's "
+                 "`uncertainty:` section, else the defaults (uncertainty_sources.h)")
       ->check(CLI::IsMember({"none", "linear", "sampling"}))
       ->capture_default_str();
   app.add_option("--samples", samples, "with --uncertainty sampling: re-registrations with sampled inputs (the linear "
@@ -74,6 +76,7 @@ int main(int argc, char** argv) {
     RegistrationOptions opt = preset_options(scene.preset);
     if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
     opt.uncertainty.enabled = uncertainty != "none";
+    opt.uncertainty.sources = scene.uncertainty;  // the defaults unless the scene's `uncertainty:` says otherwise
     // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh (the engine meshes once).
     if (scene.prone_source && cell_mm > 0) scene.prone_source->cell_size = cell_mm * 1e-3;
     RegistrationEngine engine(std::move(scene));

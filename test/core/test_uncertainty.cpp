@@ -84,7 +84,7 @@ TEST(Uncertainty, TheCovarianceIsTheSumOfItsSourcesAndTheRadiusCoversItsLargestA
     EXPECT_GT(u.d_log_youngs_modulus.norm(), 0.0);
   }
   // With no source, no spread.
-  o.uncertainty.youngs_modulus_log_sd = o.uncertainty.gravity_direction_deg = o.uncertainty.depth_noise = 0;
+  o.uncertainty.sources = UncertaintySources::none();
   for (const auto& t : RegistrationEngine(s).solve(o).tumours) EXPECT_EQ(t.uncertainty->radius_95, 0.0);
 }
 
@@ -162,8 +162,19 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
 
 TEST(Uncertainty, OptionsOutOfRangeAreRefusedAndNoSurfaceStepIsSaid) {
   UncertaintyOptions u;
-  u.depth_noise = -1;
+  u.sources.depth_noise = -1;
   expect_throw_with<InputError>([&] { validate_uncertainty_options(u); }, "depth_noise");
+  u = {};
+  u.sources.youngs_modulus_range = {3000, 200};
+  expect_throw_with<InputError>([&] { validate_uncertainty_options(u); }, "youngs_modulus_range");
+  u = {};
+  u.sources.poisson_ratio_range = {0.45, 0.5};
+  expect_throw_with<InputError>([&] { validate_uncertainty_options(u); }, "poisson_ratio_range");
+  u = {};
+  u.sources.landmark_sd = std::nan("");
+  expect_throw_with<InputError>([&] { validate_uncertainty_options(u); }, "landmark_sd_mm");
+  u.sources = UncertaintySources::none();
+  validate_uncertainty_options(u);  // every source held is valid
   Scene s = btr::test::coarse_phantom_scene();
   s.steps = {"rigid", "landmarks"};
   RegistrationOptions o = preset_options("fast");
@@ -208,6 +219,8 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
     write_registration_outputs(d, prep.scene, prep.model, with, 0);
     std::ifstream report(d + "/report.json");
     const nlohmann::json j = nlohmann::json::parse(report);
+    EXPECT_DOUBLE_EQ(j.at("uncertainty_sources").at("landmark_sd_mm").get<double>(), 1.5);  // the defaults, stated
+    EXPECT_DOUBLE_EQ(j.at("uncertainty_sources").at("youngs_modulus_range_Pa")[1].get<double>(), 3000);
     for (size_t i = 0; i < a.tumours.size(); ++i) {
       const TumourResult& t = nominal.tumours[i];
       const SurfaceMesh shell = read_surface(d + "/tumour_" + t.name + "_margin95.obj", prep.scene.units);
@@ -220,7 +233,7 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
   }
   // No source: every sample is the nominal registration.
   UncertaintyOptions none;
-  none.youngs_modulus_log_sd = none.gravity_direction_deg = none.depth_noise = 0;
+  none.sources = UncertaintySources::none();
   const SampledUncertainty z = engine.sample_uncertainty(o, none, 3, 3, nominal);
   for (const auto& t : z.tumours) {
     EXPECT_LT(t.radius_95, 1e-12);

@@ -30,6 +30,8 @@
 //   steps: auto                    # or a list of: rigid, unload, gravity, landmarks, surface
 //   preset: balanced               # fast, balanced, accurate
 //   misalignment: {rotation_deg: [0, 0, 15], translation_mm: [0, 0, 0]}  # optional, experiments
+//   uncertainty: {youngs_modulus_range: [200, 3000], landmark_sd_mm: 1.5}  # optional: the uncertain
+//                                  # inputs' distributions (uncertainty_sources.h has every field)
 #pragma once
 
 #include <array>
@@ -44,6 +46,7 @@
 #include "breast_tumour_registration/geometry/label_volume.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
+#include "breast_tumour_registration/io/uncertainty_sources.h"
 
 namespace btr {
 
@@ -96,6 +99,7 @@ struct Scene {
   std::vector<std::string> steps;        ///< empty: auto
   std::string preset = "balanced";
   Rigid misalignment = Rigid::Identity();  ///< already applied to all supine data
+  UncertaintySources uncertainty;          ///< `uncertainty`: the defaults unless the scene overrides them
   std::vector<std::string> warnings;       ///< what loading repaired (e.g. flipped faces)
 };
 

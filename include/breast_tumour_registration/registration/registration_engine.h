@@ -58,11 +58,13 @@ class RegistrationEngine {
   RegistrationResult solve_live(const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions opt,
                                 const StepCallback& callback = {});
 
-  /// Registers the scene `samples` times with its inputs drawn from `sources` (Gaussian, seeded:
-  /// ln E, the gravity tilt about both horizontal axes, and depth noise along the supine
+  /// Registers the scene `samples` times with its inputs drawn from `sources.sources` (seeded;
+  /// uncertainty_sources.h: E log-uniform over its range, Poisson's ratio uniform, the gravity
+  /// tilt about both horizontal axes, every supine landmark, and depth noise along the supine
   /// surface's vertex normals, independent per vertex), on the prepared mesh with the kept
   /// solvers; `nominal` is this engine's solve(opt). E is not sampled on an unloaded model (its
-  /// rest shape depends on E) and the noise not on a point cloud; the note says so.
+  /// rest shape depends on E) nor where the scene estimates it, and the noise not on a point
+  /// cloud; the note says so.
   SampledUncertainty sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources, int samples,
                                         unsigned seed, const RegistrationResult& nominal);
 

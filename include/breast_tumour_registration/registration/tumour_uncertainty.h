@@ -7,12 +7,14 @@
 // from three adjoint solves per tumour, lambda = H^-1 (dc/dx)^T, so that every input costs one
 // dot product: dc/dp = -lambda^T dG/dp.
 //
-// Sources (independent, Gaussian to first order): the Young's modulus of every tissue together
-// (ln E), the direction of gravity (a tilt about the two horizontal axes), and the supine
-// surface's depth noise (along its normal, per held skin vertex). Not covered: the landmark
-// step's influence on where the surface step ends (it is a start, not an input, of the
-// equilibrium), the rigid pose (held at its solution), Poisson's ratio, and model error beyond
-// these inputs.
+// Sources (uncertainty_sources.h; independent, Gaussian to first order): the Young's modulus of
+// every tissue together (ln E about the nominal, with the sd of the log-uniform range), the
+// direction of gravity (a tilt about the two horizontal axes), and the supine surface's depth
+// noise (along its normal, per held skin vertex). Not covered by the linearisation: the
+// landmarks' localisation and the landmark step's influence on where the surface step ends (it
+// is a start, not an input, of the equilibrium), the rigid pose (held at its solution),
+// Poisson's ratio, and model error beyond these inputs. Sampling (RegistrationEngine::
+// sample_uncertainty) draws every source, the landmarks and Poisson's ratio included.
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
 // exact: against re-solves of the energy it differentiates (held projections) it agrees within
@@ -32,6 +34,7 @@
 
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/geometry/surface_projector.h"
+#include "breast_tumour_registration/io/uncertainty_sources.h"
 #include "breast_tumour_registration/registration/registration_model.h"
 #include "breast_tumour_registration/registration/surface_step.h"
 
@@ -39,14 +42,10 @@ namespace btr {
 
 struct UncertaintyOptions {
   bool enabled = false;
-  /// sd of ln E (every tissue scaled together). Default: a log-uniform E over 200 to 3000 Pa,
-  /// ln(15) / sqrt(12) = 0.78, i.e. breast tissue whose stiffness nobody measured.
-  double youngs_modulus_log_sd = 0.78;
-  /// sd of the tilt of the supine gravity about each horizontal axis [deg] (a table not level,
-  /// a patient not flat).
-  double gravity_direction_deg = 2.0;
-  /// sd of the supine surface along its normal, independent per held skin vertex [m].
-  double depth_noise = 0.001;
+  /// The inputs' distributions (uncertainty_sources.h; a scene's `uncertainty:` section). The
+  /// linearisation takes ln E about the nominal modulus with the range's sd, the gravity tilt
+  /// and the depth noise; sampling draws every source.
+  UncertaintySources sources;
   /// false: linearise the projection fixed point (the skin free to slide along the scan).
   /// true: linearise the surface step's last Newton problem with its projections held (point
   /// springs holding the skin tangentially too): an equilibrium of one fixed energy, which
@@ -102,6 +101,7 @@ struct SampledUncertainty {
     Mat3 covariance = Mat3::Zero();  ///< of the sampled centroids about their mean, supine frame [m^2]
     double radius_95 = 0;            ///< [m] the 95th percentile of the distance to the nominal centroid
     Vec3 mean_shift = Vec3::Zero();  ///< sample mean minus the nominal centroid [m]
+    std::vector<Vec3> centroids;     ///< every finished sample's centroid, supine frame [m]
     /// Per vertex of the registered tumour surface: the 95th percentile of its distance to the
     /// nominal position over the samples [m] (the margin shell grows the surface by it).
     std::vector<double> vertex_radius_95;
@@ -116,6 +116,10 @@ struct SampledUncertainty {
 
 /// The 95th percentile of the distances, by the nearest rank (0 for none).
 double percentile_95(std::vector<double> distances);
+
+/// P(|X| <= r) for X ~ N(0, covariance): the level of the smallest sphere about the mean that
+/// holds a point at distance r (deterministic quadrature, 1e-4 absolute).
+double probability_within(const Mat3& covariance, double r);
 
 /// The radius of the sphere about the mean holding 95 % of N(0, covariance) (deterministic
 /// quadrature over the eigenvalues: exact to 1e-4 relative).
