@@ -1,0 +1,46 @@
+#!/bin/bash
+# Issue 14's calibration study (calibration_study.h): is the tumour's 95 % region right as often
+# as it claims, on truth whose stiffness the method does not know?
+#  1. Phantoms whose Young's modulus and Poisson's ratio are drawn over the default sources'
+#     ranges (a Latin hypercube: E log-uniform over 200 to 3000 Pa, nu uniform over 0.45 to
+#     0.499), each scene keeping the method's nominal 3400 Pa and 0.49.
+#  2. The committed truth from an independent FEM code (SfePy, P2, heterogeneous fat / gland /
+#     tumour, fat E 1000 and 3400 Pa), with the prone shape as rest and unloaded with regions.
+# Every scene is registered in BTR_CAL_DRAWS noisy copies (landmarks 1.5 mm, depth 1 mm, gravity
+# 2 deg: the sources' own draws), each with BTR_CAL_SAMPLES sampled re-registrations.
+# Usage: bash bench/run_calibration.sh OUT [phantom|independent|all]
+# Then:  /usr/bin/python3 scripts/plot_calibration.py OUT/*/calibration.csv --out OUT
+set -euo pipefail
+OUT=${1:?usage: run_calibration.sh OUT [phantom|independent|all]}
+WHAT=${2:-all}
+BODIES=${BTR_CAL_BODIES:-8} DRAWS=${BTR_CAL_DRAWS:-3} SAMPLES=${BTR_CAL_SAMPLES:-32} CELL=${BTR_CAL_CELL:-8}
+PRESET=${BTR_CAL_PRESET:-balanced}
+here=$(cd "$(dirname "$0")" && pwd)
+BIN="$here/../build/ws/devel/lib/breast_tumour_registration"
+mkdir -p "$OUT"
+if [ "$WHAT" = phantom ] || [ "$WHAT" = all ]; then
+  scenes=()
+  # Stratified E (log scale) paired with a shuffled stratified nu: a Latin hypercube, seeded.
+  while read -r E NU; do
+    d="$OUT/phantoms/E${E}_nu${NU}"
+    [ -f "$d/scene.yaml" ] || "$BIN/btr_phantom" -o "$d" -E "$E" --poisson-ratio "$NU" --cell-size "$CELL" -q > "$d.log" 2>&1 \
+      || { echo "phantom E=$E nu=$NU failed (see $d.log)"; continue; }
+    scenes+=("$d/scene.yaml")
+  done < <(/usr/bin/python3 - "$BODIES" <<'PY'
+import random, sys
+n = int(sys.argv[1])
+perm = list(range(n)); random.Random(14).shuffle(perm)
+for i in range(n):
+    e = 200 * 15 ** ((i + 0.5) / n)
+    nu = 0.45 + 0.049 * (perm[i] + 0.5) / n
+    print(round(e), round(nu, 4))
+PY
+)
+  "$BIN/btr_calibration" "${scenes[@]}" --draws "$DRAWS" --samples "$SAMPLES" -p "$PRESET" -o "$OUT/phantom" \
+    | tee "$OUT/phantom.log"
+fi
+if [ "$WHAT" = independent ] || [ "$WHAT" = all ]; then
+  data="$here/../test/data"
+  "$BIN/btr_calibration" "$data"/independent_truth_E{1000,3400}/scene_{prone,unloaded_regions}.yaml \
+    --draws "$DRAWS" --samples "$SAMPLES" -p "$PRESET" -o "$OUT/independent" | tee "$OUT/independent.log"
+fi

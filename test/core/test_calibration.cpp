@@ -1,0 +1,148 @@
+// Issue 14: the uncertainty sources a scene states, and the calibration study that checks
+// whether the sampled and linearised 95 % regions hold the true tumour centroid as often as
+// they claim.
+#include <cmath>
+#include <filesystem>
+
+#include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
+#include "breast_tumour_registration/registration/tumour_uncertainty.h"
+#include "breast_tumour_registration/simulation/calibration_study.h"
+#include "test_util.h"
+
+using namespace btr;
+using btr::test::expect_throw_with;
+using btr::test::scene_text;
+using btr::test::write_text;
+
+TEST(UncertaintySources, AScenesSectionOverridesTheDefaultsInSIAndBadFieldsAreNamed) {
+  const std::string dir = btr::test::coarse_phantom_dir();
+  const std::string path = dir + "/uncertainty.yaml";
+  write_text(path, scene_text(dir) + "uncertainty: {youngs_modulus_range: [300, 2000], poisson_ratio_range: [0, 0], "
+                                     "landmark_sd_mm: 1, depth_noise_mm: 0.5, gravity_direction_deg: 3}\n");
+  const Scene s = load_scene(path);
+  EXPECT_EQ(s.uncertainty.youngs_modulus_range[0], 300);
+  EXPECT_EQ(s.uncertainty.youngs_modulus_range[1], 2000);
+  EXPECT_FALSE(s.uncertainty.samples_poisson_ratio());
+  EXPECT_DOUBLE_EQ(s.uncertainty.landmark_sd, 1e-3);
+  EXPECT_DOUBLE_EQ(s.uncertainty.depth_noise, 5e-4);
+  EXPECT_DOUBLE_EQ(s.uncertainty.gravity_direction_deg, 3);
+  EXPECT_NEAR(s.uncertainty.youngs_modulus_log_sd(), std::log(2000.0 / 300) / std::sqrt(12.0), 1e-15);
+  // Without the section: the documented defaults.
+  const Scene d = load_scene(dir + "/scene.yaml");
+  EXPECT_EQ(d.uncertainty.youngs_modulus_range[0], 200);
+  EXPECT_EQ(d.uncertainty.youngs_modulus_range[1], 3000);
+  EXPECT_DOUBLE_EQ(d.uncertainty.landmark_sd, 1.5e-3);
+  const auto refused = [&](const std::string& section, const std::string& needle) {
+    write_text(path, scene_text(dir) + section);
+    expect_throw_with<InputError>([&] { load_scene(path); }, needle);
+  };
+  refused("uncertainty: {landmark_sd: 1}\n", "did you mean uncertainty.landmark_sd_mm");
+  refused("uncertainty: {youngs_modulus_range: [3000, 200]}\n", "youngs_modulus_range");
+  refused("uncertainty: {youngs_modulus_range: 500}\n", "uncertainty.youngs_modulus_range");
+  refused("uncertainty: {poisson_ratio_range: [0.45, 0.5]}\n", "poisson_ratio_range");
+  refused("uncertainty: {depth_noise_mm: -1}\n", "depth_noise_mm");
+  refused("uncertainty: {depth_noise_mm: one}\n", "uncertainty.depth_noise_mm");
+  refused("uncertainty: 3\n", "field 'uncertainty'");
+}
+
+TEST(UncertaintySources, ProbabilityWithinASphereIsTheChiSquareCdfAndInvertsTheRadius) {
+  // Isotropic: |X|^2 / s^2 is chi-square with 3 degrees of freedom.
+  const double s = 2e-3;
+  const Mat3 iso = s * s * Mat3::Identity();
+  for (double r : {0.5, 1.0, 2.0, 3.0}) {
+    const double x = r / std::sqrt(2.0);
+    const double chi2_3 = std::erf(x) - std::sqrt(2.0 / M_PI) * r * std::exp(-r * r / 2);
+    EXPECT_NEAR(probability_within(iso, r * s), chi2_3, 1e-4) << r;
+  }
+  Mat3 c;
+  c << 4, 1, 0, 1, 2, 0.5, 0, 0.5, 1;
+  c *= 1e-6;
+  EXPECT_NEAR(probability_within(c, radius_95(c)), 0.95, 1e-4);
+  EXPECT_EQ(probability_within(Mat3::Zero(), 1e-3), 1.0);
+}
+
+TEST(Calibration, WilsonIntervalAndObservedCoverageCountTheRowsAtEachLevel) {
+  const auto [lo, hi] = wilson_interval(95, 100);
+  EXPECT_NEAR(lo, 0.8882, 1e-3);  // the textbook values for 95 of 100
+  EXPECT_NEAR(hi, 0.9785, 1e-3);
+  std::vector<CalibrationRow> rows(10);
+  for (int i = 0; i < 10; ++i) {
+    rows[i].sampled_rank = 0.1 * i;  // 0, 0.1, ..., 0.9
+    rows[i].linear_level = i < 5 ? std::nan("") : 0.99;
+  }
+  EXPECT_DOUBLE_EQ(observed_coverage(rows, 0.45, true).observed, 0.5);
+  EXPECT_EQ(observed_coverage(rows, 0.95, true).rows, 10);
+  const Coverage l = observed_coverage(rows, 0.95, false);
+  EXPECT_EQ(l.rows, 5);  // rows without a linear region are left out
+  EXPECT_DOUBLE_EQ(l.observed, 0.0);
+  CalibrationOptions o;
+  o.samples = 1;
+  expect_throw_with<InputError>([&] { validate_calibration_options(o); }, "samples");
+}
+
+// With every source held, every noisy copy is the scene itself: the same registration error
+// as a plain solve, and a sampled region of radius zero that cannot hold a truth 0.01 mm away.
+TEST(Calibration, WithoutSourcesEveryCopyIsTheScenesOwnRegistration) {
+  Scene s = btr::test::coarse_phantom_scene();
+  s.uncertainty = UncertaintySources::none();
+  CalibrationOptions o;
+  o.registration = preset_options("fast");
+  o.draws = 2;
+  o.samples = 2;
+  std::vector<CalibrationRow> rows;
+  run_calibration({s}, o, [&](const CalibrationRow& r) { rows.push_back(r); });
+  const RegistrationResult plain = RegistrationEngine(s).solve(o.registration);
+  ASSERT_EQ(rows.size(), 2 * plain.tumours.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const TumourResult& t = plain.tumours[i % plain.tumours.size()];
+    EXPECT_EQ(rows[i].tumour, t.name);
+    EXPECT_NEAR(rows[i].error, t.centroid_distance, 1e-12);
+    EXPECT_EQ(rows[i].tilt_deg, 0.0);
+    EXPECT_LT(rows[i].sampled_radius_95, 1e-12);
+    EXPECT_GT(rows[i].error, 1e-5);
+    EXPECT_EQ(rows[i].sampled_rank, 1.0);  // every sample nearer than the truth
+  }
+  Scene no_truth = s;
+  no_truth.tumours[0].supine_ground_truth.reset();
+  expect_throw_with<InputError>([&] { run_calibration({no_truth}, o, [](const CalibrationRow&) {}); }, "supine_ground_truth");
+}
+
+// The quick coverage study: phantoms generated at two Young's moduli inside the sources' range
+// (the method's material stays the scene's 3400 Pa), three noisy copies each, 16 samples per
+// copy. With 16 exchangeable samples the "95 %" region (rank <= 0.95: within the farthest of
+// the 16) holds the truth with probability 16/17 = 0.94; 30 correlated rows cannot pin that
+// down, so this asks for what a region that is not grossly too small gives: >= 70 %. The
+// linearised region is only reported (it misses where the model is wrong: BENCHMARKS.md).
+TEST(Calibration, TheSampledRegionHoldsTheTruthOnPhantomsOfUnknownStiffness) {
+  std::vector<Scene> scenes;
+  for (double e : {600.0, 1800.0}) {
+    const std::string d = btr::test::temp_dir() + "/E" + std::to_string(static_cast<int>(e));
+    PhantomSceneOptions po;
+    po.phantom.tet.cell_size = 0.012;
+    po.phantom.surface_rings = 12;
+    po.youngs_modulus = e;
+    write_phantom_scene(d, po);
+    scenes.push_back(load_scene(d + "/scene.yaml"));
+  }
+  CalibrationOptions o;
+  o.registration = preset_options("fast");
+  o.draws = 3;
+  o.samples = 16;
+  std::vector<CalibrationRow> rows;
+  run_calibration(scenes, o, [&](const CalibrationRow& r) { rows.push_back(r); });
+  ASSERT_EQ(rows.size(), 30u);
+  const Coverage s = observed_coverage(rows, 0.95, true), l = observed_coverage(rows, 0.95, false);
+  double tilt = 0;
+  for (const auto& r : rows) {
+    EXPECT_GE(r.sampled_rank, 0.0);
+    EXPECT_LE(r.sampled_rank, 1.0);
+    EXPECT_EQ(r.sampled_rank <= 0.95, r.error <= r.sampled_radius_95) << r.scene << " " << r.tumour;
+    EXPECT_EQ(r.samples, 16);
+    tilt = std::max(tilt, r.tilt_deg);
+  }
+  EXPECT_GT(tilt, 0.1);  // the copies' gravity was tilted
+  std::printf("quick calibration: sampled 95 %% region held %.2f [%.2f, %.2f], linear %.2f of %d\n", s.observed, s.low,
+              s.high, l.observed, s.rows);
+  EXPECT_GE(s.observed, 0.7);
+}
