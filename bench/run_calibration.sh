@@ -17,7 +17,7 @@ BODIES=${BTR_CAL_BODIES:-8} DRAWS=${BTR_CAL_DRAWS:-3} SAMPLES=${BTR_CAL_SAMPLES:
 PRESET=${BTR_CAL_PRESET:-balanced}
 here=$(cd "$(dirname "$0")" && pwd)
 BIN="$here/../build/ws/devel/lib/breast_tumour_registration"
-mkdir -p "$OUT"
+mkdir -p "$OUT/phantoms"
 if [ "$WHAT" = phantom ] || [ "$WHAT" = all ]; then
   scenes=()
   # Stratified E (log scale) paired with a shuffled stratified nu: a Latin hypercube, seeded.
