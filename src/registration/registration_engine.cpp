@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <random>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -135,12 +136,15 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
   SampledUncertainty out;
   std::vector<std::string> notes;
   const UncertaintySources& src = sources.sources;
-  // E is drawn over an absolute range: the unloaded rest shape depends on it (one unload per
-  // sample is not done), and a stiffness step sets it from the landmarks in every sample.
+  // E is drawn over an absolute range, except where a stiffness step sets it from the
+  // (sampled) landmarks in every sample. An unloaded rest shape depends on the material, so a
+  // sample that draws E or Poisson's ratio unloads again (on the engine's gravity solver).
   const bool estimates_e = e.prepared.scene.youngs_modulus_range.has_value();
-  const bool sample_e = src.samples_youngs_modulus() && !model.unload && !estimates_e;
-  if (src.samples_youngs_modulus() && model.unload && !estimates_e)
-    notes.push_back("E not sampled: the unloaded rest shape depends on it (one unload per sample is not done)");
+  const bool sample_e = src.samples_youngs_modulus() && !estimates_e;
+  const bool unloaded = model.unload.has_value() && e.prepared.scene.prone_gravity.has_value();
+  const bool unload_each = unloaded && (sample_e || src.samples_poisson_ratio());
+  int unload_kept_prone = 0;
+  std::map<std::string, int> stops;  // why samples did not converge
   if (src.samples_youngs_modulus() && estimates_e)
     notes.push_back("E not sampled: the stiffness step estimates it from the (sampled) landmarks in every sample");
   const bool sample_noise = src.depth_noise > 0 && e.prepared.scene.supine_surface;
@@ -171,6 +175,11 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
     RegistrationModel m = model;
     if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);
     if (src.samples_poisson_ratio()) set_poisson_ratio(m, nu);
+    if (unload_each) {
+      set_rest_shape(m, m.prone, StepReport{});  // unload_model starts from (and may keep) the prone shape
+      const StepReport u = unload_model(m, *e.prepared.scene.prone_gravity, unload_, &e.solvers);
+      unload_kept_prone += !u.note.empty() && u.unload.rest_change == 0;
+    }
     m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
     Scene s = e.prepared.scene;
     s.preset = opt.preset;
@@ -182,7 +191,11 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
     try {
       const RegistrationResult r = run_registration(s, m, o, {}, &e.solvers);
       ++out.samples;
-      if (!r.converged) ++out.not_converged;
+      if (!r.converged) {
+        ++out.not_converged;
+        for (const auto& rep : r.reports)  // the kind of stop, without its figures
+          if (!rep.converged) ++stops[rep.name + ": " + rep.stop_reason.substr(0, rep.stop_reason.find_first_of("0123456789("))];
+      }
       for (size_t i = 0; i < r.tumours.size(); ++i) {
         centroids[i].push_back(r.tumours[i].centroid);
         const Points& V = r.tumours[i].registered.V;
@@ -214,6 +227,10 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
     }
     out.tumours.push_back(t);
   }
+  if (unload_each)
+    notes.push_back("the unloaded shape estimated again in every sample" +
+                    (unload_kept_prone ? " (" + std::to_string(unload_kept_prone) + " kept the prone shape: no better estimate)" : std::string()));
+  for (const auto& [why, n] : stops) notes.push_back(std::to_string(n) + " not converged at '" + why + "...'");
   if (out.failed) notes.push_back(std::to_string(out.failed) + " samples failed and are left out");
   for (const auto& n : notes) out.note += (out.note.empty() ? "" : "; ") + n;
   return out;

@@ -146,3 +146,23 @@ TEST(Calibration, TheSampledRegionHoldsTheTruthOnPhantomsOfUnknownStiffness) {
               s.high, l.observed, s.rows);
   EXPECT_GE(s.observed, 0.7);
 }
+
+// On an unloaded model the rest shape depends on the material: every sample that draws E
+// estimates it again, so that E is sampled there too (it used to be held, which left the
+// region blind to the stiffness exactly where the unloaded shape matters).
+TEST(Calibration, SamplingAnUnloadedModelDrawsTheStiffnessAndUnloadsInEverySample) {
+  const std::string dir = btr::test::coarse_phantom_dir();
+  const std::string path = dir + "/unloaded_sources.yaml";
+  write_text(path, scene_text(dir) + "prone_gravity: [0, 0, 9.81]\nuncertainty: {youngs_modulus_range: [1000, 3000], "
+                                     "poisson_ratio_range: [0, 0], gravity_direction_deg: 0, landmark_sd_mm: 0, depth_noise_mm: 0}\n");
+  const Scene s = load_scene(path);
+  RegistrationOptions o = preset_options("fast");
+  o.uncertainty.sources = s.uncertainty;
+  RegistrationEngine engine(s);
+  const RegistrationResult nominal = engine.solve(o);
+  ASSERT_TRUE(engine.prepare(o).model.unload);
+  const SampledUncertainty su = engine.sample_uncertainty(o, o.uncertainty, 3, 5, nominal);
+  EXPECT_EQ(su.samples, 3);
+  EXPECT_NE(su.note.find("unloaded shape estimated again in every sample"), std::string::npos) << su.note;
+  for (const auto& t : su.tumours) EXPECT_GT(t.radius_95, 1e-5);  // E alone moves the tumours
+}

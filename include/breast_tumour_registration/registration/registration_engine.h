@@ -62,9 +62,10 @@ class RegistrationEngine {
   /// uncertainty_sources.h: E log-uniform over its range, Poisson's ratio uniform, the gravity
   /// tilt about both horizontal axes, every supine landmark, and depth noise along the supine
   /// surface's vertex normals, independent per vertex), on the prepared mesh with the kept
-  /// solvers; `nominal` is this engine's solve(opt). E is not sampled on an unloaded model (its
-  /// rest shape depends on E) nor where the scene estimates it, and the noise not on a point
-  /// cloud; the note says so.
+  /// solvers; `nominal` is this engine's solve(opt). On an unloaded model every sample that
+  /// draws a material estimates the unloaded shape again. E is not sampled where the scene
+  /// estimates it (the stiffness step does, from the sampled landmarks), and the noise not on a
+  /// point cloud; the note says so.
   SampledUncertainty sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources, int samples,
                                         unsigned seed, const RegistrationResult& nominal);
 
