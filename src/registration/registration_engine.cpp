@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/registration/registration_engine.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -45,6 +47,25 @@ Scene with_supine_side(const Scene& prepared, const Scene& supine) {
   s.misalignment = supine.misalignment;
   s.warnings = supine.warnings;
   return s;
+}
+
+/// A stop reason without its parenthesized figures and with every number as '#', so that the
+/// samples' stops can be counted by kind.
+std::string without_figures(const std::string& reason) {
+  std::string out;
+  int depth = 0;
+  for (char c : reason) {
+    if (c == '(') ++depth;
+    else if (c == ')') depth = std::max(0, depth - 1);
+    else if (depth == 0) {
+      if (std::isdigit(static_cast<unsigned char>(c)) || ((c == '.' || c == 'e') && !out.empty() && out.back() == '#')) {
+        if (out.empty() || out.back() != '#') out += '#';
+      } else {
+        out += c;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -127,9 +148,27 @@ RegistrationResult RegistrationEngine::solve_live(const LiveScan& scan, const Li
 
 SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources,
                                                          int samples, unsigned seed, const RegistrationResult& nominal) {
+  Entry& e = entry(opt);
+  Scene s = e.prepared.scene;
+  s.preset = opt.preset;
+  return sample(e, s, opt, sources, samples, seed, nominal);
+}
+
+SampledUncertainty RegistrationEngine::sample_uncertainty_live(const LiveScan& scan, const LiveSceneOptions& live,
+                                                              RegistrationOptions opt, const UncertaintyOptions& sources,
+                                                              int samples, unsigned seed, const RegistrationResult& nominal) {
+  Entry& e = entry(opt);
+  LiveScene ls = live_scene(e.prepared.scene, scan, live);
+  ls.scene.preset = opt.preset;
+  opt.known_supine_to_model = ls.known_supine_to_model;
+  return sample(e, ls.scene, opt, sources, samples, seed, nominal);
+}
+
+SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, const RegistrationOptions& opt,
+                                              const UncertaintyOptions& sources, int samples, unsigned seed,
+                                              const RegistrationResult& nominal) {
   validate_uncertainty_options(sources);
   if (samples < 2) throw InputError("uncertainty sampling: at least 2 samples, got " + std::to_string(samples));
-  Entry& e = entry(opt);
   const RegistrationModel& model = e.prepared.model;
   if (nominal.tumours.size() != model.tumours.size())
     throw InputError("uncertainty sampling: the nominal result has another tumour count than the prepared model");
@@ -139,18 +178,18 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
   // E is drawn over an absolute range, except where a stiffness step sets it from the
   // (sampled) landmarks in every sample. An unloaded rest shape depends on the material, so a
   // sample that draws E or Poisson's ratio unloads again (on the engine's gravity solver).
-  const bool estimates_e = e.prepared.scene.youngs_modulus_range.has_value();
+  const bool estimates_e = scene.youngs_modulus_range.has_value();
   const bool sample_e = src.samples_youngs_modulus() && !estimates_e;
-  const bool unloaded = model.unload.has_value() && e.prepared.scene.prone_gravity.has_value();
+  const bool unloaded = model.unload.has_value() && scene.prone_gravity.has_value();
   const bool unload_each = unloaded && (sample_e || src.samples_poisson_ratio());
   int unload_kept_prone = 0;
   std::map<std::string, int> stops;  // why samples did not converge
   if (src.samples_youngs_modulus() && estimates_e)
     notes.push_back("E not sampled: the stiffness step estimates it from the (sampled) landmarks in every sample");
-  const bool sample_noise = src.depth_noise > 0 && e.prepared.scene.supine_surface;
-  if (src.depth_noise > 0 && !e.prepared.scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
+  const bool sample_noise = src.depth_noise > 0 && scene.supine_surface;
+  if (src.depth_noise > 0 && !scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
   Points normals;
-  if (sample_noise) normals = vertex_normals(*e.prepared.scene.supine_surface);
+  if (sample_noise) normals = vertex_normals(*scene.supine_surface);
   const Vec3 down = model.gravity.normalized();
   const Vec3 axes[2] = {down.unitOrthogonal(), down.cross(down.unitOrthogonal())};
   RegistrationOptions o = opt;
@@ -177,12 +216,11 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
     if (src.samples_poisson_ratio()) set_poisson_ratio(m, nu);
     if (unload_each) {
       set_rest_shape(m, m.prone, StepReport{});  // unload_model starts from (and may keep) the prone shape
-      const StepReport u = unload_model(m, *e.prepared.scene.prone_gravity, unload_, &e.solvers);
+      const StepReport u = unload_model(m, *scene.prone_gravity, unload_, &e.solvers);
       unload_kept_prone += !u.note.empty() && u.unload.rest_change == 0;
     }
     m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
-    Scene s = e.prepared.scene;
-    s.preset = opt.preset;
+    Scene s = scene;
     for (Eigen::Index l = 0; l < s.landmark_supine.rows(); ++l)
       for (int c = 0; c < 3; ++c) s.landmark_supine(l, c) += src.landmark_sd * z(rng);
     if (sample_noise)
@@ -194,7 +232,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
       if (!r.converged) {
         ++out.not_converged;
         for (const auto& rep : r.reports)  // the kind of stop, without its figures
-          if (!rep.converged) ++stops[rep.name + ": " + rep.stop_reason.substr(0, rep.stop_reason.find_first_of("0123456789("))];
+          if (!rep.converged) ++stops[rep.name + ": " + without_figures(rep.stop_reason)];
       }
       for (size_t i = 0; i < r.tumours.size(); ++i) {
         centroids[i].push_back(r.tumours[i].centroid);
@@ -230,7 +268,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
   if (unload_each)
     notes.push_back("the unloaded shape estimated again in every sample" +
                     (unload_kept_prone ? " (" + std::to_string(unload_kept_prone) + " kept the prone shape: no better estimate)" : std::string()));
-  for (const auto& [why, n] : stops) notes.push_back(std::to_string(n) + " not converged at '" + why + "...'");
+  for (const auto& [why, n] : stops) notes.push_back(std::to_string(n) + " not converged at '" + why + "'");
   if (out.failed) notes.push_back(std::to_string(out.failed) + " samples failed and are left out");
   for (const auto& n : notes) out.note += (out.note.empty() ? "" : "; ") + n;
   return out;

@@ -4,6 +4,7 @@
 #include <ros/ros.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -18,8 +19,10 @@ int main(int argc, char** argv) {
   pnh.param("truth", truth_file, truth_file);
   pnh.param("preset", preset, preset);
   pnh.param("timeout", timeout, timeout);
-  std::string uncertainty;  // "" / none, or linear: each tumour also gets its 95 % region
+  std::string uncertainty;  // "" / none, linear (each tumour also gets its 95 % region) or sampling (and a margin shell)
   pnh.param("uncertainty", uncertainty, uncertainty);
+  int samples = 0;  // with sampling: re-registrations (0: the node's 16)
+  pnh.param("samples", samples, samples);
   if (!ros::service::waitForService(service, ros::Duration(timeout))) {
     ROS_ERROR("service %s did not appear within %.0f s", service.c_str(), timeout);
     return 1;
@@ -29,6 +32,7 @@ int main(int argc, char** argv) {
   srv.request.preset = preset;
   srv.request.use_latest_cloud = true;
   srv.request.uncertainty = uncertainty;
+  srv.request.samples = static_cast<uint32_t>(std::max(0, samples));
   const ros::WallTime start = ros::WallTime::now();
   // The node answers "not yet" until a cloud has arrived and the model is tracked.
   while (ros::ok()) {
@@ -57,6 +61,7 @@ int main(int argc, char** argv) {
           std::printf(", error %.2f mm against the truth", e * 1e3);
         }
         if (t.has_uncertainty) std::printf(", 95 %% radius %.2f mm (experimental)", t.radius_95 * 1e3);
+        if (t.has_sampled_uncertainty) std::printf(", sampled 95 %% radius %.2f mm", t.radius_95_sampled * 1e3);
         std::printf("\n");
       }
       return failures;

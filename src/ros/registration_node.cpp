@@ -8,9 +8,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 
 #include "breast_tumour_registration/RegistrationResult.h"
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/geometry/margin_shell.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/registration/live_scene.h"
 #include "breast_tumour_registration/ros/converters.h"
@@ -267,9 +269,13 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
     if (!engine_) throw InputError("the node is not ready: " + scene_error_ + "; fix it and restart the node");
     const std::string preset = req.preset.empty() ? params_.preset : req.preset;
     RegistrationOptions opt = preset_options(preset);
-    if (req.uncertainty != "" && req.uncertainty != "none" && req.uncertainty != "linear")
-      throw InputError("request field 'uncertainty': '" + req.uncertainty + "' is not one of \"\", none, linear");
-    opt.uncertainty.enabled = req.uncertainty == "linear";
+    if (req.uncertainty != "" && req.uncertainty != "none" && req.uncertainty != "linear" && req.uncertainty != "sampling")
+      throw InputError("request field 'uncertainty': '" + req.uncertainty + "' is not one of \"\", none, linear, sampling");
+    const bool sampling = req.uncertainty == "sampling";
+    const int samples = req.samples == 0 ? 16 : static_cast<int>(std::min<uint32_t>(req.samples, 100000));
+    if (sampling && (samples < 2 || samples > 1000))
+      throw InputError("request field 'samples': " + std::to_string(req.samples) + " is not 0 (16) or 2 to 1000");
+    opt.uncertainty.enabled = req.uncertainty == "linear" || sampling;  // sampling gives the linear figures too
     opt.uncertainty.sources = engine_->scene().uncertainty;
     std::optional<LiveScan> scan;
     LiveSceneOptions lo;
@@ -308,7 +314,12 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       explicit Flag(std::atomic<bool>& x) : f(x) { f = true; }
       ~Flag() { f = false; }
     } running(registering_);
-    const RegistrationResult r = scan ? engine_->solve_live(*scan, lo, opt) : engine_->solve(opt);
+    RegistrationResult r = scan ? engine_->solve_live(*scan, lo, opt) : engine_->solve(opt);
+    if (sampling) {
+      publish_status(diagnostic_msgs::DiagnosticStatus::OK, "uncertainty: " + std::to_string(samples) + " sampled re-registrations running");
+      r.sampled_uncertainty = scan ? engine_->sample_uncertainty_live(*scan, lo, opt, opt.uncertainty, samples, 1, r)
+                                   : engine_->sample_uncertainty(opt, opt.uncertainty, samples, 1, r);
+    }
     publish_result(r, engine_->prepare(opt).model, preset, res.result);
     res.success = true;
     res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")";
@@ -356,6 +367,11 @@ void RegistrationNode::publish_result(const RegistrationResult& r, const Registr
   out.skin_distance_mean = r.skin_distance_mean;
   out.warnings = r.warnings;
   out.uncertainty_note = r.uncertainty_note;
+  if (r.sampled_uncertainty) {
+    const SampledUncertainty& su = *r.sampled_uncertainty;
+    out.uncertainty_note += std::string(out.uncertainty_note.empty() ? "" : "; ") + "sampled: " + std::to_string(su.samples) +
+                            " samples (" + std::to_string(su.not_converged) + " not converged)" + (su.note.empty() ? "" : ": " + su.note);
+  }
   for (const auto& s : r.reports) {
     out.step_names.push_back(s.name);
     out.step_seconds.push_back(s.seconds);
@@ -385,10 +401,26 @@ void RegistrationNode::publish_result(const RegistrationResult& r, const Registr
           tm.centroid_covariance[3 * a + b] = 0.5 * (t.uncertainty->covariance(a, b) + t.uncertainty->covariance(b, a));
       tm.radius_95 = t.uncertainty->radius_95;
     }
+    const SampledUncertainty::Tumour* st =
+        r.sampled_uncertainty && static_cast<size_t>(id) < r.sampled_uncertainty->tumours.size() ? &r.sampled_uncertainty->tumours[id] : nullptr;
+    std::optional<SurfaceMesh> shell;
+    if (st) {
+      tm.has_sampled_uncertainty = true;
+      tm.radius_95_sampled = st->radius_95;
+      if (st->vertex_radius_95.size() == static_cast<size_t>(t.registered.V.rows())) {
+        shell = margin_shell(t.registered, st->vertex_radius_95);
+        tm.margin_shell = ros_conv::to_mesh(*shell);
+      }
+    }
     out.tumours.push_back(tm);
     auto mk = ros_conv::to_marker(t.registered, frame, "tumour", id, 0.9f, 0.2f, 0.2f, 0.9f);
     mk.header.stamp = now;
     marker_pub_.publish(mk);
+    if (shell) {  // the margin shell, translucent orange around the tumour
+      auto sm = ros_conv::to_marker(*shell, frame, "margin", id, 1.0f, 0.55f, 0.1f, 0.3f);
+      sm.header.stamp = now;
+      marker_pub_.publish(sm);
+    }
     if (t.uncertainty) {  // the centroid's 95 % region, translucent yellow
       auto em = ros_conv::to_ellipsoid_marker(t.centroid, t.uncertainty->covariance, frame, "uncertainty", id, 1.0f, 0.85f, 0.2f, 0.35f);
       em.header.stamp = now;

@@ -9,6 +9,7 @@
 #include <tf2_ros/transform_listener.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -181,6 +182,32 @@ TEST(RegistrationNode, UncertaintyOnRequestAndAWrongValueIsNamed) {
   ASSERT_TRUE(ros::service::call(kService, srv));
   EXPECT_FALSE(srv.response.success);
   EXPECT_NE(srv.response.message.find("uncertainty"), std::string::npos) << srv.response.message;
+  // Sampling: the sampled radius and a margin shell per tumour, vertex for vertex the registered
+  // surface grown outwards; a sample count below 2 is named.
+  srv.request.uncertainty = "sampling";
+  srv.request.samples = 2;
+  ASSERT_TRUE(ros::service::call(kService, srv));
+  ASSERT_TRUE(srv.response.success) << srv.response.message;
+  EXPECT_NE(srv.response.result.uncertainty_note.find("sampled: 2 samples"), std::string::npos)
+      << srv.response.result.uncertainty_note;
+  for (const auto& t : srv.response.result.tumours) {
+    EXPECT_TRUE(t.has_sampled_uncertainty) << t.name;
+    EXPECT_GT(t.radius_95_sampled, 0.0) << t.name;
+    EXPECT_LT(t.radius_95_sampled, 0.05) << t.name;  // metres: not a unit slip
+    ASSERT_EQ(t.margin_shell.vertices.size(), t.mesh.vertices.size()) << t.name;
+    ASSERT_EQ(t.margin_shell.triangles.size(), t.mesh.triangles.size()) << t.name;
+    double moved = 0;
+    for (size_t v = 0; v < t.mesh.vertices.size(); ++v)
+      moved = std::max(moved, std::hypot(t.margin_shell.vertices[v].x - t.mesh.vertices[v].x,
+                                         t.margin_shell.vertices[v].y - t.mesh.vertices[v].y,
+                                         t.margin_shell.vertices[v].z - t.mesh.vertices[v].z));
+    EXPECT_GT(moved, 0.0) << t.name;
+  }
+  srv.request.samples = 1;
+  ASSERT_TRUE(ros::service::call(kService, srv));
+  EXPECT_FALSE(srv.response.success);
+  EXPECT_NE(srv.response.message.find("'samples'"), std::string::npos) << srv.response.message;
+  srv.request.samples = 0;
   // Without the field, none is computed.
   srv.request.uncertainty = "";
   ASSERT_TRUE(ros::service::call(kService, srv));

@@ -69,6 +69,12 @@ class RegistrationEngine {
   SampledUncertainty sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources, int samples,
                                         unsigned seed, const RegistrationResult& nominal);
 
+  /// The same for a live depth scan (solve_live's scene); `nominal` is this engine's
+  /// solve_live(scan, live, opt).
+  SampledUncertainty sample_uncertainty_live(const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions opt,
+                                             const UncertaintyOptions& sources, int samples, unsigned seed,
+                                             const RegistrationResult& nominal);
+
   const Scene& scene() const { return scene_; }  ///< as given
   int solvers_built() const;   ///< over every prepared mesh
   int solvers_reused() const;
@@ -80,6 +86,9 @@ class RegistrationEngine {
   };
   Entry& entry(const RegistrationOptions& opt);
   RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);
+  /// Sampling on `scene` (the prepared scene with the call's supine side).
+  SampledUncertainty sample(Entry& e, const Scene& scene, const RegistrationOptions& opt, const UncertaintyOptions& sources,
+                            int samples, unsigned seed, const RegistrationResult& nominal);
 
   Scene scene_;
   UnloadOptions unload_;
