@@ -166,3 +166,32 @@ TEST(Calibration, SamplingAnUnloadedModelDrawsTheStiffnessAndUnloadsInEverySampl
   EXPECT_NE(su.note.find("unloaded shape estimated again in every sample"), std::string::npos) << su.note;
   for (const auto& t : su.tumours) EXPECT_GT(t.radius_95, 1e-5);  // E alone moves the tumours
 }
+
+// Where the deformation is moderate (E log-uniform within a factor 2 of the nominal, the other
+// sources held, a chest ring fixing the pose), the linearised covariance is the sampled one:
+// issue 14 asks for 20 %. Compared as RMS spreads (the square root of the covariances' traces)
+// per tumour; 48 samples estimate an RMS to about 10 %. The accurate preset: the spread is a
+// few hundredths of a millimetre, and the balanced preset's stopping (0.1 mm from the fixed
+// point) blurs it (measured: ratios 1.24 to 1.38 there, 1.12 to 1.16 here).
+TEST(Calibration, TheLinearisedSpreadMatchesSampledReRegistrationsWhereTheResponseIsNearlyLinear) {
+  const Scene& s = btr::test::coarse_phantom_scene();
+  RegistrationOptions o = preset_options("accurate");
+  o.uncertainty.enabled = true;
+  o.uncertainty.sources = UncertaintySources::none();
+  const double e0 = s.material.youngs_modulus;
+  o.uncertainty.sources.youngs_modulus_range = {e0 / 2, e0 * 2};
+  RegistrationEngine engine(s);
+  const RegistrationResult nominal = engine.solve(o);
+  ASSERT_TRUE(nominal.converged) << btr::test::step_stops(nominal);
+  ASSERT_FALSE(nominal.pose_solved_with_surface);
+  const SampledUncertainty su = engine.sample_uncertainty(o, o.uncertainty, 48, 11, nominal);
+  EXPECT_EQ(su.not_converged, 0) << su.note;
+  for (size_t i = 0; i < nominal.tumours.size(); ++i) {
+    const double lin = std::sqrt(nominal.tumours[i].uncertainty->covariance.trace());
+    const double smp = std::sqrt(su.tumours[i].covariance.trace());
+    std::printf("%-7s RMS spread linear %.4f mm, sampled %.4f mm, ratio %.3f\n", nominal.tumours[i].name.c_str(), lin * 1e3,
+                smp * 1e3, lin / smp);
+    EXPECT_GT(lin / smp, 0.8) << nominal.tumours[i].name;
+    EXPECT_LT(lin / smp, 1.2) << nominal.tumours[i].name;
+  }
+}
