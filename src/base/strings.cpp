@@ -15,6 +15,12 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+std::string csv_field(std::string s) {
+  for (char& c : s)
+    if (c == ',' || c == '\n' || c == '\r' || c == '"') c = ';';
+  return s;
+}
+
 namespace {
 std::string_view without_plus(std::string_view s) {
   if (s.size() > 1 && s.front() == '+' && s[1] != '-' && s[1] != '+') s.remove_prefix(1);

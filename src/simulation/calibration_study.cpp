@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 #include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/tumour_uncertainty.h"
@@ -120,10 +121,7 @@ void write_calibration_csv_header(std::ostream& out) {
 }
 
 void write_calibration_csv_row(std::ostream& out, const CalibrationRow& r) {
-  std::string scene = r.scene;
-  for (char& c : scene)
-    if (c == ',' || c == '\n' || c == '"') c = ';';
-  out << scene << ',' << r.draw << ',' << r.tumour << ',' << std::setprecision(6) << r.tilt_deg << ',' << r.error * 1e3 << ','
+  out << csv_field(r.scene) << ',' << r.draw << ',' << csv_field(r.tumour) << ',' << std::setprecision(6) << r.tilt_deg << ',' << r.error * 1e3 << ','
       << r.sampled_radius_95 * 1e3 << ',' << r.sampled_rank << ',' << r.linear_radius_95 * 1e3 << ',' << r.linear_level << ','
       << r.samples << ',' << r.samples_not_converged << ',' << (r.converged ? 1 : 0) << ',' << std::setprecision(4) << r.seconds
       << '\n';

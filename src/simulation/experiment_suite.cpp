@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/strings.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
@@ -209,9 +210,7 @@ void write_experiment_csv_header(std::ostream& out) {
 }
 
 void write_experiment_csv_row(std::ostream& out, const ExperimentRow& row) {
-  std::string status = row.status;
-  for (char& c : status)
-    if (c == ',' || c == '\n' || c == '"') c = ';';
+  const std::string status = csv_field(row.status);
   out << row.run->experiment << ',' << row.run->setting << ',' << row.run->variable << ',' << row.run->value << ','
       << row.generating_youngs_modulus << ',' << row.tumour << ',' << std::setprecision(6) << row.centroid_distance_mm
       << ',' << row.hausdorff_mm << ',' << row.volume_ratio << ',' << std::setprecision(4) << row.seconds << ','

@@ -259,3 +259,8 @@ TEST(NumberParsing, WholeTokenOrNothing) {
   EXPECT_EQ(parse_integer("+7").value(), 7);
   for (const char* bad : {"2147483648", "1.0", "7a", "", "4294967296"}) EXPECT_FALSE(parse_integer(bad).has_value()) << bad;
 }
+
+TEST(CsvField, SeparatorsQuotesAndLineBreaksCannotSplitARow) {
+  EXPECT_EQ(csv_field("stalled: a, b \"c\"\r\nd"), "stalled: a; b ;c;;;d");
+  EXPECT_EQ(csv_field("plain"), "plain");
+}

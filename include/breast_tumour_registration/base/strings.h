@@ -11,6 +11,8 @@ namespace btr {
 std::string lower_case(std::string s);
 /// Whether `s` ends with `suffix` (case-sensitive).
 bool ends_with(const std::string& s, const std::string& suffix);
+/// `s` as one unquoted CSV field: commas, quotes and line breaks become ';'.
+std::string csv_field(std::string s);
 
 /// The whole of `s` as a number, through std::from_chars (locale-free; one leading '+' is
 /// allowed, as files written by other tools have it; "inf" and "nan" parse, callers that need
