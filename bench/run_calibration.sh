@@ -8,7 +8,7 @@
 #     tumour, fat E 1000 and 3400 Pa), with the prone shape as rest and unloaded with regions.
 # Every scene is registered in BTR_CAL_DRAWS noisy copies (landmarks 1.5 mm, depth 1 mm, gravity
 # 2 deg: the sources' own draws), each with BTR_CAL_SAMPLES sampled re-registrations.
-# Usage: bash bench/run_calibration.sh OUT [phantom|independent|all]
+# Usage: bash bench/run_calibration.sh OUT [phantom|independent|all]   (BTR_CAL_* below: sizes)
 # Then:  /usr/bin/python3 scripts/plot_calibration.py OUT/*/calibration.csv --out OUT
 set -euo pipefail
 OUT=${1:?usage: run_calibration.sh OUT [phantom|independent|all]}
@@ -40,7 +40,18 @@ PY
     | tee "$OUT/phantom.log"
 fi
 if [ "$WHAT" = independent ] || [ "$WHAT" = all ]; then
+  # One process per fat modulus (the two cores), each with the prone-as-rest and the unloaded
+  # scene; then one CSV.
   data="$here/../test/data"
-  "$BIN/btr_calibration" "$data"/independent_truth_E{1000,3400}/scene_{prone,unloaded_regions}.yaml \
-    --draws "$DRAWS" --samples "$SAMPLES" -p "$PRESET" -o "$OUT/independent" | tee "$OUT/independent.log"
+  for E in ${BTR_CAL_FAT:-1000 3400}; do
+    "$BIN/btr_calibration" "$data/independent_truth_E$E/scene_prone.yaml" "$data/independent_truth_E$E/scene_unloaded_regions.yaml" \
+      --draws "$DRAWS" --samples "$SAMPLES" -p "$PRESET" -o "$OUT/independent_E$E" > "$OUT/independent_E$E.log" 2>&1 &
+  done
+  wait
+  mkdir -p "$OUT/independent"
+  first=1
+  for E in ${BTR_CAL_FAT:-1000 3400}; do
+    if [ $first = 1 ]; then cat "$OUT/independent_E$E/calibration.csv"; first=0; else tail -n +2 "$OUT/independent_E$E/calibration.csv"; fi
+  done > "$OUT/independent/calibration.csv"
+  cat "$OUT"/independent_E*.log
 fi
