@@ -183,7 +183,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   const bool unloaded = model.unload.has_value() && scene.prone_gravity.has_value();
   const bool unload_each = unloaded && (sample_e || src.samples_poisson_ratio());
   int unload_kept_prone = 0;
-  std::map<std::string, int> stops;  // why samples did not converge
+  std::map<std::string, int> stops, failures;  // why samples did not converge, or failed
   if (src.samples_youngs_modulus() && estimates_e)
     notes.push_back("E not sampled: the stiffness step estimates it from the (sampled) landmarks in every sample");
   const bool sample_noise = src.depth_noise > 0 && scene.supine_surface;
@@ -211,22 +211,22 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     const auto& nr = src.poisson_ratio_range;
     const double nu = nr[0] + (nr[1] - nr[0]) * unit(rng);
     const double tilt[2] = {src.gravity_direction_deg * M_PI / 180 * z(rng), src.gravity_direction_deg * M_PI / 180 * z(rng)};
-    RegistrationModel m = model;
-    if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);
-    if (src.samples_poisson_ratio()) set_poisson_ratio(m, nu);
-    if (unload_each) {
-      set_rest_shape(m, m.prone, StepReport{});  // unload_model starts from (and may keep) the prone shape
-      const StepReport u = unload_model(m, *scene.prone_gravity, unload_, &e.solvers);
-      unload_kept_prone += !u.note.empty() && u.unload.rest_change == 0;
-    }
-    m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
     Scene s = scene;
     for (Eigen::Index l = 0; l < s.landmark_supine.rows(); ++l)
       for (int c = 0; c < 3; ++c) s.landmark_supine(l, c) += src.landmark_sd * z(rng);
     if (sample_noise)
       for (Eigen::Index v = 0; v < s.supine_surface->V.rows(); ++v)
         s.supine_surface->V.row(v) += src.depth_noise * z(rng) * normals.row(v);
-    try {
+    try {  // a sample whose material cannot be unloaded or registered is left out, not the sampling
+      RegistrationModel m = model;
+      if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);
+      if (src.samples_poisson_ratio()) set_poisson_ratio(m, nu);
+      if (unload_each) {
+        set_rest_shape(m, m.prone, StepReport{});  // unload_model starts from (and may keep) the prone shape
+        const StepReport u = unload_model(m, *scene.prone_gravity, unload_, &e.solvers);
+        unload_kept_prone += !u.note.empty() && u.unload.rest_change == 0;
+      }
+      m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
       const RegistrationResult r = run_registration(s, m, o, {}, &e.solvers);
       ++out.samples;
       if (!r.converged) {
@@ -242,8 +242,9 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
           for (Eigen::Index v = 0; v < V.rows(); ++v)
             vertex_distances[i][static_cast<size_t>(v)].push_back((V.row(v) - V0.row(v)).norm());
       }
-    } catch (const std::exception&) {
+    } catch (const std::exception& err) {
       ++out.failed;
+      ++failures[without_figures(err.what())];
     }
   }
   out.seconds_per_sample = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / samples;
@@ -269,7 +270,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     notes.push_back("the unloaded shape estimated again in every sample" +
                     (unload_kept_prone ? " (" + std::to_string(unload_kept_prone) + " kept the prone shape: no better estimate)" : std::string()));
   for (const auto& [why, n] : stops) notes.push_back(std::to_string(n) + " not converged at '" + why + "'");
-  if (out.failed) notes.push_back(std::to_string(out.failed) + " samples failed and are left out");
+  for (const auto& [why, n] : failures) notes.push_back(std::to_string(n) + " failed and left out: '" + why + "'");
   for (const auto& n : notes) out.note += (out.note.empty() ? "" : "; ") + n;
   return out;
 }
