@@ -81,6 +81,11 @@ StableNeoHookean::StableNeoHookean(double E, double nu) {
   lambda_ = l.lambda + l.mu;
 }
 
+double StableNeoHookean::youngs_modulus() const {
+  const double lambda_lame = lambda_ - mu_;
+  return mu_ * (3 * lambda_lame + 2 * mu_) / (lambda_lame + mu_);
+}
+
 StableNeoHookean StableNeoHookean::from_lame(double mu, double lambda_lame) {
   if (!(mu > 0) || !(lambda_lame >= 0) || !std::isfinite(mu) || !std::isfinite(lambda_lame))
     throw InputError("Lame parameters must satisfy mu > 0 and lambda >= 0");

@@ -33,11 +33,7 @@ void scale_stiffness(RegistrationModel& model, double scale) {
 
 void set_poisson_ratio(RegistrationModel& model, double nu) {
   if (!(nu >= 0 && nu < 0.5)) throw InputError("Poisson's ratio must be in [0, 0.5), got " + std::to_string(nu));
-  for (auto& m : model.materials) {
-    const double mu = m.mu(), lambda_l = m.lambda() - mu;
-    const double youngs = mu * (3 * lambda_l + 2 * mu) / (lambda_l + mu);
-    m = StableNeoHookean(youngs, nu);
-  }
+  for (auto& m : model.materials) m = StableNeoHookean(m.youngs_modulus(), nu);
   model.material.poisson_ratio = nu;
 }
 

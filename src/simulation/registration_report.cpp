@@ -126,9 +126,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                            : 1.0;
   Json materials = Json::array();
   for (size_t i = 0; i < model.materials.size(); ++i) {
-    const double mu = scale * model.materials[i].mu(), lambda_lame = scale * model.materials[i].lambda() - mu;
     materials.push_back({{"name", i < model.material_names.size() ? model.material_names[i] : ""},
-                         {"youngs_modulus_Pa", num(mu * (3 * lambda_lame + 2 * mu) / (lambda_lame + mu))},
+                         {"youngs_modulus_Pa", num(scale * model.materials[i].youngs_modulus())},
                          {"tetrahedra", i < model.material_tetrahedra.size() ? model.material_tetrahedra[i] : 0}});
   }
   j["materials"] = materials;

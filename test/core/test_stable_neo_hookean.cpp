@@ -144,6 +144,8 @@ TEST(StableNeoHookean, LinearizationIsLinearElasticityWithTheGivenLameParameters
     const double expected = 2 * l.mu * S.squaredNorm() + l.lambda * G.trace() * G.trace();
     EXPECT_NEAR(g.dot(H0 * g), expected, 1e-9 * expected);
   }
+  // The Young's modulus it reports is the one it was made from, at any Poisson's ratio.
+  for (double n : {0.0, 0.3, 0.45, 0.499}) EXPECT_NEAR(StableNeoHookean(E, n).youngs_modulus(), E, 1e-9 * E) << n;
 }
 
 TEST(StableNeoHookean, ParameterRangeErrors) {

@@ -44,6 +44,8 @@ class StableNeoHookean {
 
   double mu() const { return mu_; }          ///< shear modulus [Pa]
   double lambda() const { return lambda_; }  ///< SNH volume stiffness lambda_L + mu [Pa]
+  /// Young's modulus [Pa] of the small-strain limit: mu (3 lambda_L + 2 mu) / (lambda_L + mu).
+  double youngs_modulus() const;
 
   /// Energy density psi(F) [J/m^3].
   double psi(const Mat3& F) const;
