@@ -190,8 +190,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   if (src.depth_noise > 0 && !scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
   Points normals;
   if (sample_noise) normals = vertex_normals(*scene.supine_surface);
-  const Vec3 down = model.gravity.normalized();
-  const Vec3 axes[2] = {down.unitOrthogonal(), down.cross(down.unitOrthogonal())};
+  const std::array<Vec3, 2> axes = gravity_tilt_axes(model.gravity);
   RegistrationOptions o = opt;
   o.uncertainty.enabled = false;
   std::mt19937 rng(seed);

@@ -48,6 +48,12 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
 
 void validate_uncertainty_options(const UncertaintyOptions& o) { validate_uncertainty_sources(o.sources); }
 
+std::array<Vec3, 2> gravity_tilt_axes(const Vec3& gravity) {
+  const Vec3 down = gravity.normalized();
+  const Vec3 a0 = down.unitOrthogonal();
+  return {a0, down.cross(a0)};
+}
+
 double probability_within(const Mat3& covariance, double r) {
   Eigen::SelfAdjointEigenSolver<Mat3> es(0.5 * (covariance + covariance.transpose()));
   return chi_square_mixture_cdf(es.eigenvalues().cwiseMax(0.0), r);
@@ -129,13 +135,11 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // Inputs' dG/dp on the free DOFs.
   const Eigen::VectorXd b_E = H.gather(elastic.gradient(x));  // G_elastic is linear in E: dG/d ln E = G_elastic
   Eigen::VectorXd b_g[2];
-  Vec3 axes[2] = {Vec3::Zero(), Vec3::Zero()};
+  std::array<Vec3, 2> axes = {Vec3::Zero(), Vec3::Zero()};
   const bool gravity = surface.gravity && model.gravity.norm() > 0;
   if (gravity) {
     const GravityEnergy g(model.rest, model.material.density, model.gravity);
-    const Vec3 down = model.gravity.normalized();
-    axes[0] = down.unitOrthogonal();
-    axes[1] = down.cross(axes[0]);
+    axes = gravity_tilt_axes(model.gravity);
     for (int k = 0; k < 2; ++k) {
       const Vec3 dg = axes[k].cross(model.gravity);  // a tilt by d theta about axes[k]
       Eigen::VectorXd full(3 * nv);

@@ -30,8 +30,7 @@ Scene noisy_copy(const Scene& s, const UncertaintySources& src, std::mt19937& rn
     const Points n = vertex_normals(*d.supine_surface);
     for (Eigen::Index v = 0; v < d.supine_surface->V.rows(); ++v) d.supine_surface->V.row(v) += src.depth_noise * z(rng) * n.row(v);
   }
-  const Vec3 down = s.gravity.normalized();
-  const Vec3 a0 = down.unitOrthogonal(), a1 = down.cross(a0);
+  const auto [a0, a1] = gravity_tilt_axes(s.gravity);
   const double sd = src.gravity_direction_deg * M_PI / 180;
   const double t0 = sd * z(rng), t1 = sd * z(rng);
   tilt = Rigid::Identity();

@@ -27,6 +27,7 @@
 // coverage is not calibrated.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <utility>
@@ -116,6 +117,10 @@ struct SampledUncertainty {
 
 /// The 95th percentile of the distances, by the nearest rank (0 for none).
 double percentile_95(std::vector<double> distances);
+
+/// The two horizontal axes the gravity-direction source tilts about (both the linearisation and
+/// the sampling): a unit vector orthogonal to `gravity`, then gravity's direction crossed with it.
+std::array<Vec3, 2> gravity_tilt_axes(const Vec3& gravity);
 
 /// P(|X| <= r) for X ~ N(0, covariance): the level of the smallest sphere about the mean that
 /// holds a point at distance r (deterministic quadrature, 1e-4 absolute).
