@@ -233,8 +233,12 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     if (!r.steps.surface || !supine) {
       r.uncertainty_note = "not computed: it linearises the surface step's equilibrium, and the surface step did not run";
     } else {
+      // The map the surface step computed: its sliding held only if it was (it is not where the
+      // alternation contracts quickly).
+      SurfaceStepOptions computed = opt.surface;
+      if (r.reports.back().sliding_held_from == 0) computed.sliding = SkinSliding::Free;
       const UncertaintyResult u =
-          linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, opt.surface, opt.uncertainty);
+          linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed, opt.uncertainty);
       for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
       r.uncertainty_seconds = u.seconds;
       std::vector<std::string> notes;

@@ -31,6 +31,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   if (opt.anderson_depth < 0 || opt.floor_projections < 1 || opt.stall_projections < 1 || !(opt.projection_tolerance >= 0))
     throw InputError("surface step: anderson_depth must be >= 0, floor_projections and stall_projections >= 1, "
                      "projection_tolerance a number >= 0");
+  if (!(opt.hold_contraction >= 0 && opt.hold_contraction <= 1))
+    throw InputError("surface step: hold_contraction must be a number in [0, 1], got " + std::to_string(opt.hold_contraction));
 
   TotalEnergy energy;
   add_model_elastic_energy(energy, model);
@@ -60,6 +62,13 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
 
   // The springs for the projections of the skin of xs (and, with a free pose, the pose that
   // best fits xs to the previous correspondences). Returns how many skin vertices they hold.
+  // SkinSliding::HeldWhereSettled: from the settled state on, each held skin vertex's point
+  // spring keeps (along the surface) the closest point the vertex had there: one spring with the
+  // point weight to that anchor and the plane weight to the current tangent plane is the spring
+  // K = w_p I + w_n n n^T with the target anchor + n w_n/(w_p + w_n) n.(closest - anchor).
+  bool hold_sliding = false;
+  std::vector<Vec3> anchor(model.skin.size());
+  std::vector<char> anchored(model.skin.size(), 0);
   auto project_at = [&](const Points& xs, bool update_pose) {
     const auto tp = std::chrono::steady_clock::now();
     springs->clear();
@@ -68,8 +77,16 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     if (pose && update_pose && free_springs->size() >= 3) P = free_springs->pose(xs);  // fewer: keep the last pose
     for (size_t i = 0; i < model.skin.size(); ++i) {
       const int v = model.skin[i];
-      const Projection c = supine.project(P * Vec3(xs.row(v).transpose()));
+      Projection c = supine.project(P * Vec3(xs.row(v).transpose()));
       if (!holds_projection(c, opt)) continue;
+      if (hold_sliding) {
+        if (!anchored[i]) {  // held only from now on: anchored where it is first held
+          anchor[i] = c.point;
+          anchored[i] = 1;
+        }
+        const Vec3 u = c.normal.normalized();
+        c.point = anchor[i] + u * (opt.plane_weight / (opt.point_weight + opt.plane_weight) * u.dot(c.point - anchor[i]));
+      }
       const Eigen::Index k = static_cast<Eigen::Index>(held.size());
       if (pose) {
         held_y.row(k) = c.point.transpose();
@@ -228,6 +245,19 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     if (outer == opt.max_projections) {
       x = g;
       break;
+    }
+    // A creep: the skin moves less than the tolerance per projection but slides on along the
+    // scan at a contraction of hold_contraction or more. With HeldWhereSettled its sliding is
+    // held from here: the anchors are this state's closest points.
+    if (!hold_sliding && opt.sliding == SkinSliding::HeldWhereSettled && opt.point_weight > 0 && fallback_at > 0 &&
+        q_hat >= opt.hold_contraction) {
+      hold_sliding = true;
+      rep.sliding_held_from = outer;
+      for (size_t i = 0; i < model.skin.size(); ++i) {
+        const Projection c = supine.project(P * Vec3(g.row(model.skin[i]).transpose()));
+        anchored[i] = holds_projection(c, opt);
+        anchor[i] = c.point;
+      }
     }
     // The next iterate: Anderson's proposal where it lowers the merit without inverting more
     // elements than the plain step, else the plain step (and the history starts over).

@@ -108,12 +108,15 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   add_model_elastic_energy(elastic, model);
   // A held target moving by delta along n moves both springs' targets: dG/d delta = -spring n.
   const double spring = surface.point_weight + surface.plane_weight;
-  // Held projections: the springs as the surface step has them; else a projection that follows
-  // the vertex along the surface leaves only the normal direction, with both springs' weight.
+  // Held projections, or sliding held where the skin settled: the point spring holds the vertex
+  // along the surface too (its anchor stays), the plane spring along the normal; with free
+  // sliding, a projection that follows the vertex along the surface leaves only the normal
+  // direction, with both springs' weight.
+  const bool held_along = opt.held_projections || surface.sliding == SkinSliding::HeldWhereSettled;
   auto springs = std::make_shared<SpringEnergy>("held skin");
   for (const HeldSkinVertex& h : held)
-    springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, opt.held_projections ? surface.point_weight : 0,
-                                 opt.held_projections ? surface.plane_weight : spring);
+    springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, held_along ? surface.point_weight : 0,
+                                 held_along ? surface.plane_weight : spring);
   if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
   TotalEnergy jac;
   for (const auto& t : elastic.terms()) jac.add(t);

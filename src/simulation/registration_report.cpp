@@ -45,6 +45,7 @@ Json step_report(const StepReport& s) {
             {"fixed_point_distance_mm", num(s.fixed_point_distance * 1e3)},
             {"contraction", num(s.contraction)},
             {"accelerated_projections", s.accelerated_projections},
+            {"sliding_held_from_projection", s.sliding_held_from},
             {"projection_rms_changes_mm", changes},
             {"constrained_skin_vertices", s.constrained_skin},
             {"skin_vertices", s.skin_vertices},

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <random>
 #include <sstream>
@@ -293,6 +294,7 @@ TEST(SurfaceStep, InterpolatedNormalsContractToTheFixedPointOnASoftBreast) {
   for (const MeshNormals n : {MeshNormals::Face, MeshNormals::Interpolated}) {
     RegistrationOptions o = preset_options("balanced");
     o.surface.target_normals = n;
+    o.surface.sliding = SkinSliding::Free;  // the thesis's alternation, which the normals change
     r[n] = run_registration(s, m, o);
   }
   const RegistrationResult& smooth = r[MeshNormals::Interpolated];
@@ -751,4 +753,20 @@ TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
   EXPECT_LT(worst_error(aligned), worst_error(told) + 0.05e-3) << worst_error(aligned) * 1e3 << " vs " << worst_error(told) * 1e3;
   std::printf("ring-free phantom: aligned %.3f mm, misaligned %.3f mm, told the pose %.3f mm\n", worst_error(aligned) * 1e3,
               worst_error(moved) * 1e3, worst_error(told) * 1e3);
+}
+
+TEST(SurfaceStep, OptionsOutOfRangeAreNamed) {
+  const Scene& s = test::coarse_phantom_scene();
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(s, warnings);
+  const auto supine = make_mesh_projector(*s.supine_surface);
+  Points x = m.rest.V;
+  SurfaceStepOptions o;
+  for (const double q : {1.5, -0.1, std::numeric_limits<double>::quiet_NaN()}) {
+    o.hold_contraction = q;
+    expect_throw_with<InputError>([&] { surface_step(m, *supine, o, x); }, "hold_contraction must be a number in [0, 1]");
+  }
+  o = SurfaceStepOptions{};
+  o.stall_projections = 0;
+  expect_throw_with<InputError>([&] { surface_step(m, *supine, o, x); }, "stall_projections");
 }

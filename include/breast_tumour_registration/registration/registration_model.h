@@ -35,6 +35,9 @@ struct StepReport {
   /// contracting), and the projections that took an Anderson-accelerated iterate
   double contraction = 0, fixed_point_distance = 0;
   int accelerated_projections = 0;
+  /// surface step: the projection from which the skin's sliding along the scan was held where
+  /// it settled (SkinSliding::HeldWhereSettled; 0: free throughout)
+  int sliding_held_from = 0;
   /// surface step: the held skin's RMS motion [m] at each projection, in order (how the
   /// alternation converged, stalled or jittered)
   std::vector<double> projection_residuals;

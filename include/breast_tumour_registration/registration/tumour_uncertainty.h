@@ -1,9 +1,12 @@
 // Where the tumour may be: the linearised uncertainty of every registered tumour centroid
 // (issue 14). At the surface step's equilibrium the gradient G(x, p) vanishes; for an uncertain
 // input p the equilibrium moves by dx/dp = -H^-1 dG/dp (implicit differentiation). H is the
-// Jacobian of the converged projection fixed point: the exact elastic Hessian with the chest
-// wall fixed, plus (w_point + w_plane) n n^T per held skin vertex (re-projecting onto the
-// surface frees the tangential part of the point springs). The centroid's sensitivities come
+// Jacobian of the surface step's converged fixed point: the exact elastic Hessian with the chest
+// wall fixed, plus per held skin vertex the springs that hold it there. With the skin's sliding
+// held where it settled (SkinSliding::HeldWhereSettled, the default) those are w_point I +
+// w_plane n n^T: the point spring keeps its anchor along the surface. With free sliding
+// (SkinSliding::Free), (w_point + w_plane) n n^T: re-projecting onto the surface frees the
+// tangential part of the point springs. The centroid's sensitivities come
 // from three adjoint solves per tumour, lambda = H^-1 (dc/dx)^T, so that every input costs one
 // dot product: dc/dp = -lambda^T dG/dp.
 //
@@ -18,12 +21,10 @@
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
 // exact: against re-solves of the energy it differentiates (held projections) it agrees within
-// 2 % (test Uncertainty.HeldProjection*). What is not: the registration's answer is not that
-// equilibrium. The skin slides slowly along the scan between projections (a few um per
-// projection even far past the presets' tolerances, on a facetted surface), so where the
-// surface step stops, and the landmark step it started from, set the tangential position; on
-// the 4 mm phantom the re-solved response to E agrees along gravity within about 10 % but the
-// response to a gravity tilt is 2.5x the fixed point's and changes sign between presets. The
+// 2 % (test Uncertainty.HeldProjection*). What it leaves out: where the skin settled (the anchors)
+// depends on the inputs too, through the landmark step and the approach to the scan; with free
+// sliding the skin creeps along the scan and where the step stops sets its tangential position
+// (on the 4 mm phantom the re-solved response to a gravity tilt was 2.5x the fixed point's). The
 // coverage is not calibrated.
 #pragma once
 
@@ -47,7 +48,8 @@ struct UncertaintyOptions {
   /// linearisation takes ln E about the nominal modulus with the range's sd, the gravity tilt
   /// and the depth noise; sampling draws every source.
   UncertaintySources sources;
-  /// false: linearise the projection fixed point (the skin free to slide along the scan).
+  /// false: linearise the surface step's fixed point as its sliding option has it (held along
+  /// the scan where it settled, or free to slide).
   /// true: linearise the surface step's last Newton problem with its projections held (point
   /// springs holding the skin tangentially too): an equilibrium of one fixed energy, which
   /// re-solves can reach to round-off, so that the machinery is checked exactly (tests).
