@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   app.add_option("--labels", table_path, "label table (YAML): which label value or segment name is which tissue");
   app.add_option("-o,--out", out_dir, "scene folder (created)")->capture_default_str();
   auto* cell_opt = app.add_option("--cell-size", cell_mm, "tetrahedron size bound [mm]; default: the preset's simulation mesh "
-                                                            "(fast 9, balanced 7; accurate 7), which the preset then simulates as it is")
+                                                            "(fast 9, balanced 7, accurate 4), which the preset then simulates as it is")
                        ->check(btr::cli::positive());
   app.add_option("--tumour-facet-size", tumour_facet_mm, "facet size bound on the tumours' surfaces [mm]")
       ->capture_default_str()
