@@ -64,11 +64,7 @@ void expect_finite(const Outcome& o) {
   for (const auto& s : o.r.reports) EXPECT_TRUE(std::isfinite(s.energy)) << s.name;
 }
 
-double worst(const Outcome& o) {
-  double w = 0;
-  for (const auto& t : o.r.tumours) w = std::max(w, t.centroid_distance);
-  return w;
-}
+double worst(const Outcome& o) { return btr::test::worst_error(o.r); }
 
 }  // namespace
 

@@ -26,6 +26,7 @@ using namespace btr;
 using btr::test::expect_throw_with;
 using btr::test::make_rigid;
 using btr::test::step_stops;
+using btr::test::worst_error;
 
 namespace {
 
@@ -71,11 +72,6 @@ RegistrationResult register_scene(const std::string& path, const std::string& pr
   return run_registration(s, m, preset_options(preset));
 }
 
-double worst_error(const RegistrationResult& r) {
-  double w = 0;
-  for (const auto& t : r.tumours) w = std::max(w, t.centroid_distance);
-  return w;
-}
 
 
 }  // namespace

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -53,6 +54,13 @@ inline std::string step_stops(const RegistrationResult& r) {
   std::string s;
   for (const auto& rep : r.reports) s += rep.name + (rep.converged ? " (converged): " : " (not converged): ") + rep.stop_reason + "\n";
   return s;
+}
+
+/// The largest tumour centroid error of a registration [m].
+inline double worst_error(const RegistrationResult& r) {
+  double w = 0;
+  for (const auto& t : r.tumours) w = std::max(w, t.centroid_distance);
+  return w;
 }
 
 inline void write_text(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
