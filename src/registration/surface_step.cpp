@@ -66,7 +66,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   // spring keeps (along the surface) the closest point the vertex had there: one spring with the
   // point weight to that anchor and the plane weight to the current tangent plane is the spring
   // K = w_p I + w_n n n^T with the target anchor + n w_n/(w_p + w_n) n.(closest - anchor).
-  bool hold_sliding = false;
+  // Held from projection rep.sliding_held_from (0: not held).
   std::vector<Vec3> anchor(model.skin.size());
   std::vector<char> anchored(model.skin.size(), 0);
   auto project_at = [&](const Points& xs, bool update_pose) {
@@ -79,7 +79,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       const int v = model.skin[i];
       Projection c = supine.project(P * Vec3(xs.row(v).transpose()));
       if (!holds_projection(c, opt)) continue;
-      if (hold_sliding) {
+      if (rep.sliding_held_from > 0) {
         if (!anchored[i]) {  // held only from now on: anchored where it is first held
           anchor[i] = c.point;
           anchored[i] = 1;
@@ -249,9 +249,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // A creep: the skin moves less than the tolerance per projection but slides on along the
     // scan at a contraction of hold_contraction or more. With HeldWhereSettled its sliding is
     // held from here: the anchors are this state's closest points.
-    if (!hold_sliding && opt.sliding == SkinSliding::HeldWhereSettled && opt.point_weight > 0 && fallback_at > 0 &&
+    if (rep.sliding_held_from == 0 && opt.sliding == SkinSliding::HeldWhereSettled && opt.point_weight > 0 && fallback_at > 0 &&
         q_hat >= opt.hold_contraction) {
-      hold_sliding = true;
       rep.sliding_held_from = outer;
       for (size_t i = 0; i < model.skin.size(); ++i) {
         const Projection c = supine.project(P * Vec3(g.row(model.skin[i]).transpose()));
