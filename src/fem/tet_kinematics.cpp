@@ -61,14 +61,17 @@ Mat12 tet_hessian_from_stress_hessian(const Mat9& H9, const Mat3& Dinv, double v
   return volume * K;
 }
 
+bool is_inverted(const Points& x, const Tetrahedra& T, Eigen::Index t) {
+  const Vec3 a = x.row(T(t, 0));
+  const double v = (x.row(T(t, 1)).transpose() - a).dot((x.row(T(t, 2)).transpose() - a).cross(x.row(T(t, 3)).transpose() - a));
+  return !(v > 0);
+}
+
 long count_inverted(const Points& x, const Tetrahedra& T) {
   long n = 0;
 #pragma omp parallel for reduction(+ : n) schedule(static)
-  for (Eigen::Index t = 0; t < T.rows(); ++t) {
-    const Vec3 a = x.row(T(t, 0));
-    const double v = (x.row(T(t, 1)).transpose() - a).dot((x.row(T(t, 2)).transpose() - a).cross(x.row(T(t, 3)).transpose() - a));
-    if (!(v > 0)) ++n;
-  }
+  for (Eigen::Index t = 0; t < T.rows(); ++t)
+    if (is_inverted(x, T, t)) ++n;
   return n;
 }
 

@@ -6,6 +6,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/units.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/validation.h"
@@ -215,6 +216,14 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
     TumourResult tr;
     tr.name = mt.name;
     tr.registered = transform_surface(to_supine, {apply_embedding(mt.embedding, model.rest.T, r.x), mt.prone.F});
+    // A tumour vertex in an inverted tetrahedron moves with a folded map: its place is not to be trusted.
+    long in_inverted = 0;
+    for (Eigen::Index p = 0; p < mt.embedding.tet.size(); ++p)
+      if (is_inverted(r.x, model.rest.T, mt.embedding.tet(p))) ++in_inverted;
+    if (in_inverted > 0)
+      r.warnings.push_back("tumour " + mt.name + ": " + std::to_string(in_inverted) + " of its " +
+                           std::to_string(mt.embedding.tet.size()) +
+                           " vertices lie in inverted tetrahedra; its registered shape folds there");
     tr.centroid = volume_centroid(tr.registered);
     tr.volume_ratio = enclosed_volume(tr.registered) / enclosed_volume(mt.prone);
     tr.axis_ratio = principal_axis_ratio(tr.registered);

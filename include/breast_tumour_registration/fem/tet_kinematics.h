@@ -35,6 +35,8 @@ Mat9x12 deformation_gradient_jacobian(const Mat3& Dm_inv);
 Vec12 tet_gradient_from_stress(const Mat3& P, const Mat3& Dm_inv, double volume);
 /// The 12x12 matrix volume * B^T H9 B of a 9x9 d2psi/dvec(F)2, in a third of the dense flops.
 Mat12 tet_hessian_from_stress_hessian(const Mat9& H9, const Mat3& Dm_inv, double volume);
+/// Whether tetrahedron t of T has a non-positive signed volume at positions x.
+bool is_inverted(const Points& x, const Tetrahedra& T, Eigen::Index t);
 /// Number of tetrahedra with non-positive signed volume at positions x.
 long count_inverted(const Points& x, const Tetrahedra& T);
 
