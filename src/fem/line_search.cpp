@@ -17,7 +17,10 @@ LineSearchResult backtracking_line_search(const TotalEnergy& energy, const Point
     const double E = energy.value(x_out);
     if (!std::isfinite(E) || E > E0 + opt.armijo * alpha * std::min(slope, 0.0)) continue;
     const long inv = T.rows() ? count_inverted(x_out, T) : 0;
-    if (opt.forbid_new_inversions && inv > inverted0) continue;
+    if (opt.forbid_new_inversions && inv > inverted0) {
+      r.inversion_limited = true;
+      continue;
+    }
     r.accepted = true;
     r.alpha = alpha;
     r.energy = E;

@@ -59,6 +59,7 @@ StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets,
   info.alpha = ls.alpha;
   info.step_norm = ls.alpha * full_step;
   info.inverted = n_inv;
+  info.inversion_limited = ls.inversion_limited;
   return StepOutcome::Taken;
 }
 
@@ -253,6 +254,15 @@ NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, con
     info.gradient_norm = g.norm();
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
+    if (local.forbid_new_inversions && info.inversion_limited && info.alpha <= opt.inversion_stall_alpha) {
+      // The inversion rule, not the energy, cut the step short: let the line search invert
+      // from here (the guard keeps this state if the solve then folds the mesh).
+      local.forbid_new_inversions = false;
+      res.inversions_allowed = true;
+      guard.arm(res, x, E, n_inv);
+      fresh_factor = true;
+      continue;
+    }
     if (info.step_norm <= opt.step_tolerance) {  // accepted, but too short to make progress
       if (exact) {
         leave_exact();

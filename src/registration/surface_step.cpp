@@ -33,6 +33,9 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                      "projection_tolerance a number >= 0");
   if (!(opt.hold_contraction >= 0 && opt.hold_contraction <= 1))
     throw InputError("surface step: hold_contraction must be a number in [0, 1], got " + std::to_string(opt.hold_contraction));
+  if (!(opt.inversion_stall_alpha >= 0 && opt.inversion_stall_alpha <= 1))
+    throw InputError("surface step: inversion_stall_alpha must be a number in [0, 1], got " +
+                     std::to_string(opt.inversion_stall_alpha));
 
   TotalEnergy energy;
   add_model_elastic_energy(energy, model);
@@ -50,6 +53,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   NewtonSolver& solver = (cache ? *cache : local).newton(pose ? "surface (pose free)" : "surface", model, energy.hessian_cliques());
   NewtonOptions nopt = opt.newton;
   nopt.max_iterations = opt.newton_per_projection;
+  nopt.inversion_stall_alpha = opt.inversion_stall_alpha;
   if (nopt.force_scale <= 0) nopt.force_scale = gravity->total_weight();
 
   StepReport rep;
@@ -140,7 +144,6 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   // (a fold, a stall, the cap), so that the stricter criterion never leaves a worse answer.
   Points fallback;
   int fallback_at = 0;
-  long fallback_inverted = 0;
   bool aborted = false;
   std::vector<double>& residuals = rep.projection_residuals;  // per projection [m]
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
@@ -171,6 +174,22 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       rep.stop_reason = "Newton " + rep.stop_reason + " (gradient " + std::to_string(r.gradient_norm) + " N)";
       break;
     }
+    // A stall let this Newton invert elements: the rest of the step may too (one alternation is
+    // one solve; a fresh rule per projection would stall it again). The projection's change,
+    // cut short by the rule, is no sign of settling: it is not counted.
+    if (r.inversions_allowed && nopt.forbid_new_inversions) {
+      nopt.forbid_new_inversions = false;
+      rep.inversions_allowed = true;
+      if (outer < opt.max_projections) {
+        x = g;
+        if (aa) aa->reset();
+        rep.constrained_skin = project_at(x, true);
+        merit = energy.value(x);
+        inverted_now = r.inverted;
+        finished = false;
+        continue;
+      }
+    }
     // The fixed-point residual and the contraction between this iterate and the last; the
     // bound needs two contraction estimates (the first step, from the landmark step's state,
     // contracts far more than the slow tangential relaxation after it).
@@ -186,7 +205,6 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     if (fallback_at == 0 && outer > 1 && residual <= opt.projection_tolerance) {
       fallback = g;
       fallback_at = outer;
-      fallback_inverted = r.inverted;
     }
     // The alternation's floor: on a polyhedral surface the closest points switch between
     // faces, and the skin ends jittering by a few hundredths of a millimetre per projection
@@ -299,7 +317,8 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   // passing a nearly flat state where soft tissue meets stiff springs) it is the answer the
   // criteria found, and the count is reported; returning the earlier state instead was measured
   // to cost accuracy on both bodies (BENCHMARKS.md, "Inverted elements at the limit"). Beyond
-  // the allowance the mesh folded to meet the scan: the earlier state is kept when it has fewer.
+  // the allowance the mesh folded to meet the scan: not converged (the earlier state is returned
+  // where there is one).
   // (x is the last Newton's result on every exit, so its count is rep.inverted.)
   const long newly_inverted = rep.inverted - inverted_start;
   if (rep.converged && newly_inverted > 0) {
@@ -307,7 +326,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     if (static_cast<double>(newly_inverted) <= allowance) {
       rep.stop_reason += "; " + std::to_string(rep.inverted) + " tetrahedra ended inverted (" + std::to_string(newly_inverted) +
                          " new, within the allowance of " + std::to_string(static_cast<long>(allowance)) + ")";
-    } else if (fallback_at > 0 && fallback_inverted < rep.inverted) {
+    } else {
       rep.converged = false;
       rep.stop_reason += ", but " + std::to_string(rep.inverted) + " tetrahedra ended inverted (" +
                          std::to_string(newly_inverted) + " new, beyond the allowance of " +

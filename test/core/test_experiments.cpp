@@ -9,6 +9,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
@@ -292,40 +293,79 @@ TEST(ExperimentShards, MergedSharesEqualTheUnshardedSuite) {
 
 namespace btr {
 
-// Issue 10: a surface-step limit with a few tetrahedra newly inverted (soft tissue under the
-// skin springs passing a nearly flat state) is the answer its criteria found: converged, the
-// count reported, and closer to the truth than the earlier state the step returned instead
-// before (phantom at 8 mm, 400 Pa truth, gravity + surface: 10.6 mm then, 1.0 mm now).
-TEST(SurfaceStep, ALimitWithAFewInvertedElementsIsConvergedAndCounted) {
-  PhantomOptions po;
-  po.tet.cell_size = 0.008;
-  const PhantomModel model = make_phantom_model(po);
-  PhantomSceneOptions gen;
-  gen.youngs_modulus = 400;
-  const PhantomConfigurations conf = simulate_phantom(model, gen);
+namespace {
+
+// One quick-suite run on the 8 mm phantom (7.3k tetrahedra) generated at 400 Pa, registered
+// with the balanced preset; returns the result and its surface step.
+struct SoftRun {
+  RegistrationResult r;
+  StepReport surface;
+  long tetrahedra = 0;
+};
+SoftRun soft_phantom_run(const std::string& experiment, const std::string& setting, const std::string& variable,
+                         const std::string& value) {
+  static const PhantomModel model = [] {
+    PhantomOptions po;
+    po.tet.cell_size = 0.008;
+    return make_phantom_model(po);
+  }();
+  static const PhantomConfigurations conf = [] {
+    PhantomSceneOptions gen;
+    gen.youngs_modulus = 400;
+    return simulate_phantom(model, gen);
+  }();
   ExperimentSuiteOptions o;
   o.quick = true;
-  o.experiments = {"practical"};
+  o.experiments = {experiment};
   const auto runs = plan_experiments(o);
-  const auto run = std::find_if(runs.begin(), runs.end(), [](const ExperimentRun& r) { return r.setting == "gravity+surface"; });
-  ASSERT_NE(run, runs.end());
+  const auto run = std::find_if(runs.begin(), runs.end(),
+                                [&](const ExperimentRun& r) { return r.setting == setting && r.variable == variable && r.value == value; });
+  if (run == runs.end()) throw std::runtime_error("no run " + experiment + "/" + setting + " = " + value);
   RegistrationEngine engine(experiment_scene(model, conf, *run, "balanced", "prone"));
-  const RegistrationResult r = engine.solve(preset_options("balanced"));
-  const StepReport* surface = nullptr;
-  for (const auto& rep : r.reports)
-    if (rep.name.rfind("surface", 0) == 0) surface = &rep;
-  ASSERT_NE(surface, nullptr);
-  const long allowance = static_cast<long>(NewtonOptions{}.max_inverted_fraction_after_stall * model.rest.T.rows());
-  EXPECT_TRUE(surface->converged) << surface->stop_reason;
-  EXPECT_GT(surface->inverted, 0) << "the case no longer exercises the allowance: " << surface->stop_reason;
-  EXPECT_LE(surface->inverted, allowance) << surface->stop_reason;
-  EXPECT_NE(surface->stop_reason.find("tetrahedra ended inverted"), std::string::npos) << surface->stop_reason;
+  SoftRun out;
+  RegistrationOptions ro = preset_options("balanced");
+  ro.landmark.weight = run->landmark_weight;
+  out.r = engine.solve(ro);
+  for (const auto& rep : out.r.reports)
+    if (rep.name.rfind("surface", 0) == 0) out.surface = rep;
+  out.tetrahedra = model.rest.T.rows();
+  return out;
+}
+
+}  // namespace
+
+// Issue 10: a surface-step limit with a few tetrahedra newly inverted is the answer its criteria
+// found: converged, the count in the stop reason and a warning. Before, the step returned the
+// earlier state where the skin first moved less than the tolerance, reported as not converged,
+// which cost accuracy on both bodies of the quick suite (BENCHMARKS.md, "Inverted elements at the
+// limit"). The case: the thesis's method given a scan shifted 10 mm along z without the rigid step.
+TEST(SurfaceStep, ALimitWithAFewInvertedElementsIsConvergedAndCounted) {
+  const SoftRun s = soft_phantom_run("misalignment", "without_rigid", "translation_z_mm", "10");
+  const long allowance = static_cast<long>(NewtonOptions{}.max_inverted_fraction_after_stall * s.tetrahedra);
+  EXPECT_TRUE(s.surface.converged) << s.surface.stop_reason;
+  EXPECT_GT(s.surface.inverted, 0) << "the case no longer exercises the allowance: " << s.surface.stop_reason;
+  EXPECT_LE(s.surface.inverted, allowance) << s.surface.stop_reason;
+  EXPECT_NE(s.surface.stop_reason.find("within the allowance of " + std::to_string(allowance)), std::string::npos)
+      << s.surface.stop_reason;
   bool warned = false;
-  for (const auto& w : r.warnings) warned = warned || w.find("tetrahedra ended inverted") != std::string::npos;
+  for (const auto& w : s.r.warnings) warned = warned || w.find("tetrahedra ended inverted") != std::string::npos;
   EXPECT_TRUE(warned);
-  EXPECT_LT(test::worst_error(r), 1.5e-3);
-  std::printf("400 Pa phantom, gravity + surface: %ld of %ld tetrahedra inverted (allowance %ld), worst tumour %.3f mm\n",
-              surface->inverted, static_cast<long>(model.rest.T.rows()), allowance, test::worst_error(r) * 1e3);
+  std::printf("400 Pa phantom, 10 mm shift without the rigid step: %ld of %ld tetrahedra inverted (allowance %ld), worst tumour %.3f mm\n",
+              s.surface.inverted, s.tetrahedra, allowance, test::worst_error(s.r) * 1e3);
+}
+
+// Issue 10: where every full step would invert an element, the line search used to crawl with
+// ever shorter steps (alpha 1/64 ... 1e-9) at a gradient of 590 N; the skin then barely moved
+// per projection and passed for settled, and the step ended not converged on a state far from
+// equilibrium, 12.6 mm off (phantom at 8 mm, 400 Pa truth, surface alone). A step the rule cuts
+// to 1/8 or less now lets the line search invert for the rest of the step.
+TEST(SurfaceStep, AStepCutShortByTheInversionRuleIsAStallNotASettledSkin) {
+  const SoftRun s = soft_phantom_run("practical", "surface", "method", "surface");
+  EXPECT_TRUE(s.surface.converged) << s.surface.stop_reason;
+  EXPECT_TRUE(s.surface.inversions_allowed) << "the case no longer meets the inversion rule: " << s.surface.stop_reason;
+  EXPECT_LT(test::worst_error(s.r), 1.5e-3);
+  std::printf("400 Pa phantom, surface alone: %s, %ld tetrahedra inverted at the end, worst tumour %.3f mm\n",
+              s.surface.converged ? "converged" : "not converged", s.surface.inverted, test::worst_error(s.r) * 1e3);
 }
 
 }  // namespace btr

@@ -3,6 +3,9 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/fem/line_search.h"
+#include "breast_tumour_registration/fem/spring_energy.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/geometry/box_mesh.h"
 #include "breast_tumour_registration/geometry/validation.h"
@@ -137,4 +140,36 @@ TEST(NewtonSolver, StallsAreRetriedThenReportedAsStalls) {
   EXPECT_FALSE(recover_from_stall(StepOutcome::TooSmall, false, o, r));
   EXPECT_TRUE(r.converged);
   EXPECT_EQ(r.reason, StopReason::StepTolerance);
+}
+
+// The line search says when the no-new-inversion rule, not the energy, chose alpha: a spring
+// pulls the apex of one tetrahedron through its base (the full step inverts it; alpha = 1/2
+// leaves it exactly flat, also refused; 1/4 is taken). Without the rule alpha = 1 is taken.
+TEST(LineSearch, SaysWhenTheInversionRuleCutTheStep) {
+  Points x(4, 3);
+  x << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  Tetrahedra T(1, 4);
+  T << 0, 1, 2, 3;
+  ASSERT_EQ(count_inverted(x, T), 0);
+  TotalEnergy energy;
+  auto spring = std::make_shared<SpringEnergy>();
+  spring->add_point(Anchor::vertex(3), Vec3(0, 0, -1), 10.0);
+  energy.add(spring);
+  Points dx = Points::Zero(4, 3);
+  dx(3, 2) = -2;  // the exact minimiser of the spring
+  const double E0 = energy.value(x);
+  const double slope = -2 * 10.0 * 2;  // g . dx with g_z = 10 * (1 - (-1)) = 20 at the apex
+  Points out;
+  LineSearchOptions o;
+  const LineSearchResult ruled = backtracking_line_search(energy, x, dx, E0, slope, 0, T, o, out);
+  ASSERT_TRUE(ruled.accepted);
+  EXPECT_TRUE(ruled.inversion_limited);
+  EXPECT_DOUBLE_EQ(ruled.alpha, 0.25);
+  EXPECT_EQ(ruled.inverted, 0);
+  o.forbid_new_inversions = false;
+  const LineSearchResult free = backtracking_line_search(energy, x, dx, E0, slope, 0, T, o, out);
+  ASSERT_TRUE(free.accepted);
+  EXPECT_FALSE(free.inversion_limited);
+  EXPECT_DOUBLE_EQ(free.alpha, 1.0);
+  EXPECT_EQ(free.inverted, 1);
 }

@@ -763,6 +763,11 @@ TEST(SurfaceStep, OptionsOutOfRangeAreNamed) {
     expect_throw_with<InputError>([&] { surface_step(m, *supine, o, x); }, "hold_contraction must be a number in [0, 1]");
   }
   o = SurfaceStepOptions{};
+  for (const double a : {1.5, -0.1, std::numeric_limits<double>::quiet_NaN()}) {
+    o.inversion_stall_alpha = a;
+    expect_throw_with<InputError>([&] { surface_step(m, *supine, o, x); }, "inversion_stall_alpha must be a number in [0, 1]");
+  }
+  o = SurfaceStepOptions{};
   o.stall_projections = 0;
   expect_throw_with<InputError>([&] { surface_step(m, *supine, o, x); }, "stall_projections");
 }

@@ -18,6 +18,9 @@ struct LineSearchResult {
   double alpha = 0;
   double energy = 0;
   long inverted = 0;
+  /// A longer step met the Armijo condition but inverted tetrahedra the current state has not:
+  /// the inversion rule, not the energy, set alpha.
+  bool inversion_limited = false;
 };
 
 /// Tries x + alpha dx for alpha = 1, 1/2, ...; on acceptance x_out holds the new state.

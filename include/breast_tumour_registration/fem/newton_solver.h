@@ -39,6 +39,7 @@ struct IterationInfo {
   double t_assembly = 0, t_factorization = 0, t_solve = 0, t_line_search = 0;  ///< this iteration [s]
   bool factorized = false;  ///< this iteration factorized (false: PCG on the lagged factor)
   int pcg_iterations = 0;
+  bool inversion_limited = false;  ///< the inversion rule cut the step (LineSearchResult::inversion_limited)
 };
 
 struct NewtonOptions {
@@ -71,6 +72,12 @@ struct NewtonOptions {
   /// state, reported); more means the mesh folded to meet its constraints, and the last
   /// uninverted state is kept (StopReason::InvertedAfterStall).
   double max_inverted_fraction_after_stall = 0.002;
+  /// A step that the inversion rule cut to this fraction of the Newton step or less is a stall
+  /// of its own kind: the line search may invert from then on (as recover_from_stall does; the
+  /// inversion guard above still applies). 0: only steps below step_tolerance are stalls. The
+  /// surface step sets it (SurfaceStepOptions): soft tissue pulled by the skin springs otherwise
+  /// crawls with ever shorter steps, far from equilibrium, and its skin looks settled.
+  double inversion_stall_alpha = 0;
   /// Called after every accepted iteration; return false to abort.
   std::function<bool(const IterationInfo&)> callback;
 };

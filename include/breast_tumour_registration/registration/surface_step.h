@@ -83,6 +83,14 @@ struct SurfaceStepOptions {
   /// HeldWhereSettled: the contraction per projection from which a settled skin's sliding is a
   /// creep, and is held.
   double hold_contraction = 0.95;
+  /// Newton's inversion_stall_alpha in this step: a step the no-new-inversion rule cut to this
+  /// fraction or less lets the line search invert for the rest of the step (soft tissue under
+  /// the skin springs otherwise crawls far from equilibrium with ever shorter steps, and the
+  /// small change per projection passes for a settled skin: BENCHMARKS.md, "Inverted elements
+  /// at the limit"). A limit that then folds beyond Newton's allowance is not converged.
+  /// 1/8 was chosen on two bodies (1/128, 1/32, 1/8, 1/2, 1 measured; from 1/8 up the same
+  /// not-converged counts and errors, 1/8 with the fewest runs made worse).
+  double inversion_stall_alpha = 1.0 / 8;
   NewtonOptions newton;
 };
 
