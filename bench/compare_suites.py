@@ -1,16 +1,73 @@
 #!/usr/bin/python3
-"""Run by run comparison of two btr_experiments results.csv files of the same plan: the worst
-tumour centroid error [mm] and seconds of each run in A and in B, with the status where either
-did not converge. Usage: /usr/bin/python3 bench/compare_suites.py A.csv B.csv"""
-import csv,sys,collections
+"""Compare btr_experiments results.csv files of the same plan; a run's error is its worst tumour
+centroid error [mm].
+
+  compare_suites.py A.csv B.csv
+      run by run: the error and seconds in A and in B, with the status where either did not converge
+  compare_suites.py --changed A.csv B.csv [--by MM]
+      only the runs whose error moved by more than MM (default 0.03) or whose convergence changed
+  compare_suites.py --summary NAME=A.csv NAME=B.csv ...
+      a line per file: runs not converged, median and mean error (also without the thesis's
+      misalignment runs without the rigid step), runs better / worse by more than 0.1 mm than the
+      first file, and the full method's error per generating E
+"""
+import collections, csv, statistics, sys
+
+
 def load(p):
-    d=collections.OrderedDict()
+    d = collections.OrderedDict()
     for r in csv.DictReader(open(p)):
-        k=(r['experiment'],r['setting'],r['variable'],r['value'],r['generating_youngs_modulus_Pa'])
-        e=d.setdefault(k,[0,'',0])
-        e[0]=max(e[0],float(r['centroid_distance_mm'])); e[1]=r['status'][:110]; e[2]=float(r['seconds'])
+        k = (r['experiment'], r['setting'], r['variable'], r['value'], r['generating_youngs_modulus_Pa'])
+        e = d.setdefault(k, [0, '', 0])
+        e[0] = max(e[0], float(r['centroid_distance_mm'])); e[1] = r['status']; e[2] = float(r['seconds'])
     return d
-a=load(sys.argv[1]); b=load(sys.argv[2])
-for k in a:
-    print(k, "%.3f %.1fs | %.3f %.1fs"%(a[k][0],a[k][2],b[k][0],b[k][2]))
-    if a[k][1]!='converged' or b[k][1]!='converged': print("    A:",a[k][1]); print("    B:",b[k][1])
+
+
+def converged(status):
+    return status.startswith('converged')
+
+
+def run_by_run(a, b):
+    for k in a:
+        print(k, "%.3f %.1fs | %.3f %.1fs" % (a[k][0], a[k][2], b[k][0], b[k][2]))
+        if a[k][1] != 'converged' or b[k][1] != 'converged':
+            print("    A:", a[k][1][:110]); print("    B:", b[k][1][:110])
+
+
+def changed(a, b, by):
+    for k in a:
+        (wa, sa, _), (wb, sb, _) = a[k], b[k]
+        if abs(wa - wb) > by or converged(sa) != converged(sb):
+            tag = lambda s: 'C' if converged(s) else 'NC'
+            print(f"{k[4]:>5} {k[0]}/{k[1]} {k[2]}={k[3]}: {wa:.3f} -> {wb:.3f} mm, {tag(sa)} -> {tag(sb)}"
+                  + ("" if converged(sb) else "   | " + sb[:150]))
+
+
+def summary(named):
+    base = None
+    for name, path in named:
+        d = load(path)
+        base = base or d
+        nc = sum(1 for v in d.values() if not converged(v[1]))
+        ws = [v[0] for v in d.values()]
+        core = [v[0] for k, v in d.items() if k[1] != 'without_rigid']
+        better = sum(1 for k in d if d[k][0] < base[k][0] - 0.1)
+        worse = sum(1 for k in d if d[k][0] > base[k][0] + 0.1)
+        full = [d[k][0] for k in d if k[0] == 'practical' and k[1] == 'full']
+        print(f"| {name} | {nc} of {len(d)} | {statistics.median(ws):.3f} | {statistics.mean(ws):.3f} | "
+              f"{statistics.mean(core):.3f} | {better} / {worse} | {' / '.join(f'{x:.3f}' for x in full)} |")
+
+
+if __name__ == '__main__':
+    args = sys.argv[1:]
+    if args and args[0] == '--summary':
+        print("| file | not converged | median [mm] | mean [mm] | mean without `without_rigid` [mm] | better / worse than the first | full method per E [mm] |")
+        print("|---|---|---|---|---|---|---|")
+        summary([a.split('=', 1) for a in args[1:]])
+    elif args and args[0] == '--changed':
+        by = float(args[args.index('--by') + 1]) if '--by' in args else 0.03
+        changed(load(args[1]), load(args[2]), by)
+    elif len(args) == 2:
+        run_by_run(load(args[0]), load(args[1]))
+    else:
+        sys.exit(__doc__)
