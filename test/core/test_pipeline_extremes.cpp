@@ -76,9 +76,10 @@ void expect_inversions_reported(const Outcome& o) {
   bool warned = false;
   for (const auto& w : o.r.warnings) warned = warned || w.find("tetrahedra ended inverted") != std::string::npos;
   EXPECT_TRUE(warned) << o.inverted << " inverted, no warning says so\n" << btr::test::step_stops(o.r);
-  if (o.r.converged)
+  if (o.r.converged) {
     EXPECT_LE(static_cast<double>(o.inverted), NewtonOptions{}.max_inverted_fraction_after_stall * static_cast<double>(o.tetrahedra))
         << btr::test::step_stops(o.r);
+  }
 }
 
 }  // namespace
@@ -118,7 +119,9 @@ TEST_P(PipelineWeights, LandmarkAndSurfaceWeightsFromOneToHundredMillion) {
   EXPECT_EQ(o.inverted, 0);
   std::printf("weights %g N/m: worst tumour error %.3f mm, landmark residual %.3f mm\n", w, worst(o) * 1e3,
               o.r.landmark_residual_max * 1e3);
-  if (w >= 1e2 && w <= 1e6) EXPECT_LT(worst(o), 1e-3);
+  if (w >= 1e2 && w <= 1e6) {
+    EXPECT_LT(worst(o), 1e-3);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Extremes, PipelineWeights, ::testing::Values(1.0, 1e2, 1e4, 1e6, 1e8));
