@@ -178,8 +178,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // one solve; a fresh rule per projection would stall it again). The projection's change,
     // cut short by the rule, is no sign of settling: it is not counted.
     if (r.inversions_allowed && nopt.forbid_new_inversions) {
-      nopt.forbid_new_inversions = false;
-      rep.inversions_allowed = true;
+      nopt.forbid_new_inversions = false;  // rep.inversions_allowed is set by add_newton_profile
       if (outer < opt.max_projections) {
         x = g;
         if (aa) aa->reset();
