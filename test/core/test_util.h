@@ -56,6 +56,13 @@ inline std::string step_stops(const RegistrationResult& r) {
   return s;
 }
 
+/// Whether any of the registration's warnings contains `text`.
+inline bool has_warning(const RegistrationResult& r, const std::string& text) {
+  for (const auto& w : r.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
 /// The largest tumour centroid error of a registration [m].
 inline double worst_error(const RegistrationResult& r) {
   double w = 0;
