@@ -7,9 +7,12 @@
 #include <pcl/registration/icp.h>
 #include <pcl/search/kdtree.h>
 
+#include <Eigen/Eigenvalues>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
+#include <vector>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/nearest_sample_grid.h"
@@ -157,18 +160,32 @@ template <class Nearest>
 void judge(const Cloud& src, const Cloud& tgt, const Nearest& nearest, const IcpOptions& opt, IcpResult& r) {
   double sq = 0;
   long inliers = 0;
+  std::vector<Vec3> moved, normals;
+  std::vector<double> residuals;
   for (const auto& p : src) {
     const Vec3 q = r.transform * Vec3(p.x, p.y, p.z);
     const int j = nearest(q);
     if (j < 0) continue;
     const auto& t = tgt[j];
     if ((q - Vec3(t.x, t.y, t.z)).norm() > opt.max_correspondence_distance) continue;
-    const double dist = (q - Vec3(t.x, t.y, t.z)).dot(Vec3(t.normal_x, t.normal_y, t.normal_z));
+    const Vec3 n(t.normal_x, t.normal_y, t.normal_z);
+    const double dist = (q - Vec3(t.x, t.y, t.z)).dot(n);
     sq += dist * dist;
     ++inliers;
+    moved.push_back(q);
+    normals.push_back(n);
+    residuals.push_back(dist);
   }
   r.overlap = src.empty() ? 0.0 : static_cast<double>(inliers) / src.size();
   r.inlier_rms = inliers ? std::sqrt(sq / inliers) : std::numeric_limits<double>::infinity();
+  Points Q(static_cast<Eigen::Index>(moved.size()), 3), N(static_cast<Eigen::Index>(moved.size()), 3);
+  for (size_t i = 0; i < moved.size(); ++i) {
+    Q.row(static_cast<Eigen::Index>(i)) = moved[i].transpose();
+    N.row(static_cast<Eigen::Index>(i)) = normals[i].transpose();
+  }
+  r.pose_covariance = point_to_plane_pose_covariance(
+      Q, N, Eigen::Map<const Eigen::VectorXd>(residuals.data(), static_cast<Eigen::Index>(residuals.size())),
+      r.pose_covariance_note);
   if (!r.converged) r.message = "ICP did not converge";
   else if (r.overlap < opt.min_overlap) r.message = "ICP overlap " + std::to_string(r.overlap) + " below " + std::to_string(opt.min_overlap);
   else if (r.inlier_rms > opt.max_inlier_rms) r.message = "ICP inlier RMS " + std::to_string(r.inlier_rms * 1e3) + " mm above the bound";
@@ -198,6 +215,43 @@ void check_options(const IcpOptions& opt) {
 }
 
 }  // namespace
+
+std::optional<Mat6> point_to_plane_pose_covariance(const Points& q, const Points& n, const Eigen::VectorXd& residuals,
+                                                   std::string& note) {
+  note.clear();
+  const Eigen::Index m = q.rows();
+  if (m < 7 || n.rows() != m || residuals.size() != m) {
+    note = "the pose covariance needs at least 7 inlier pairs, got " + std::to_string(m);
+    return std::nullopt;
+  }
+  // Whether every direction is determined is judged about the pairs' centroid with rotations
+  // scaled by the region's RMS radius (both leave the rank unchanged and make the scale free).
+  const Vec3 c = q.colwise().mean().transpose();
+  const double radius = std::sqrt((q.rowwise() - c.transpose()).rowwise().squaredNorm().mean());
+  Mat6 A = Mat6::Zero(), A_scaled = Mat6::Zero();
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const Vec3 qi = q.row(i).transpose(), ni = n.row(i).transpose();
+    Vec6 J, Js;
+    J << qi.cross(ni), ni;
+    Js << (qi - c).cross(ni) / std::max(radius, 1e-12), ni;
+    A += J * J.transpose();
+    A_scaled += Js * Js.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Mat6> es(A_scaled);
+  const double top = es.eigenvalues()(5);
+  if (!(top > 0) || es.eigenvalues()(0) < 1e-6 * top) {
+    const Vec6 v = es.eigenvectors().col(0);
+    char b[200];
+    std::snprintf(b, sizeof b, "rotation (%.2f, %.2f, %.2f), translation (%.2f, %.2f, %.2f)", v(0), v(1), v(2), v(3), v(4),
+                  v(5));
+    note = std::string("the region does not determine the pose along the motion ") + b +
+           " (about its centroid): a plane, a sphere or a surface of revolution";
+    return std::nullopt;
+  }
+  const double sigma2 = residuals.squaredNorm() / static_cast<double>(m - 6);
+  const Mat6 cov = sigma2 * A.ldlt().solve(Mat6::Identity());
+  return Mat6(0.5 * (cov + cov.transpose()));
+}
 
 IcpResult align_icp(const Points& source, const Points& target, const Rigid& initial, const IcpOptions& opt) {
   const auto t0 = std::chrono::steady_clock::now();

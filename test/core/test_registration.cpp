@@ -14,6 +14,7 @@
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/surface_projector.h"
+#include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/io/index_io.h"
 #include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/registration/icp_alignment.h"
@@ -113,6 +114,44 @@ TEST(Icp, ChecksItsResultAndRejectsBadClouds) {
   Points nan = ring.V;
   nan(3, 2) = std::numeric_limits<double>::quiet_NaN();
   expect_throw_with<InputError>([&] { align_icp(nan, ring.V, Rigid::Identity(), IcpOptions{}); }, "NaN");
+}
+
+TEST(Icp, PoseCovarianceMatchesTheSpreadOverNoisyScans) {
+  // The chest ring seen with 1 mm depth noise along its normals, 30 times: the pose errors'
+  // Mahalanobis distance under the fit's own covariance must average 6 (chi-square, 6 dof).
+  // Too small an estimate (the residuals read as noise-free) gives far more, too large far less.
+  const SurfaceMesh ring = make_chest_ring(0.07, 0.06, 0.04, 144);
+  const Points n = vertex_normals(ring);
+  const Rigid T = make_rigid(Vec3(0.3, -0.2, 0.4), Vec3(0.004, -0.003, 0.002));  // supine -> model
+  std::mt19937 rng(7);
+  std::normal_distribution<double> z(0.0, 1.0);
+  const int draws = 30;
+  double mahalanobis = 0, sd_rotation_deg = 0;
+  for (int k = 0; k < draws; ++k) {
+    Points noisy = ring.V;
+    for (Eigen::Index v = 0; v < noisy.rows(); ++v) noisy.row(v) += 0.001 * z(rng) * n.row(v);
+    const IcpResult r = align_icp(transform_points(T.inverse(), noisy), ring.V, Rigid::Identity(), IcpOptions{});
+    ASSERT_TRUE(r.accepted) << r.message;
+    ASSERT_TRUE(r.pose_covariance.has_value()) << r.pose_covariance_note;
+    const Rigid err = r.transform * T.inverse();  // exp(xi)
+    const Eigen::AngleAxisd aa(err.linear());
+    Vec6 xi;
+    xi << aa.angle() * aa.axis(), err.translation();
+    mahalanobis += xi.dot(r.pose_covariance->ldlt().solve(xi)) / draws;
+    sd_rotation_deg += std::sqrt(r.pose_covariance->topLeftCorner<3, 3>().trace()) * 180 / M_PI / draws;
+  }
+  std::printf("ICP pose covariance: mean Mahalanobis %.2f (chi-square 6 dof: 6), rotation sd %.3f deg\n", mahalanobis,
+              sd_rotation_deg);
+  EXPECT_GT(mahalanobis, 4.0);
+  EXPECT_LT(mahalanobis, 9.0);
+}
+
+TEST(Icp, APlaneLeavesThePoseUndeterminedAndSaysSo) {
+  const SurfaceMesh disc = make_chest_ring(0.07, 0.06, 0.04, 144, 1e6);  // flat to a micrometre
+  const IcpResult r = align_icp(disc.V, disc.V, Rigid::Identity(), IcpOptions{});
+  EXPECT_TRUE(r.accepted) << r.message;
+  EXPECT_FALSE(r.pose_covariance.has_value());
+  EXPECT_NE(r.pose_covariance_note.find("does not determine the pose"), std::string::npos) << r.pose_covariance_note;
 }
 
 TEST(SkinningSubspace, ReproducesAffineMapsAndKeepsTheChestWallFixed) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "breast_tumour_registration/geometry/rigid_transform.h"
@@ -34,7 +35,23 @@ struct IcpResult {
   int iterations = 0;
   double seconds = 0;
   std::string message;        ///< why it was (not) accepted
+  /// How well the fit determines the pose: the covariance of a small motion xi = (omega, tau)
+  /// [rad, m] applied after `transform` in the target frame (transform' = exp(xi) transform),
+  /// from the point-to-plane normal equations at the solution, sigma^2 (sum_i J_i^T J_i)^-1
+  /// with J_i = [(q_i x n_i)^T, n_i^T] over the inlier pairs (q_i the moved source point, n_i the
+  /// target normal) and sigma^2 the inlier residuals' sum of squares over (pairs - 6). It treats
+  /// the pairs' residuals as independent (downsampled points), so it says nothing of an error
+  /// shared by all of them (a wrong correspondence basin, a deformed region). Empty when the
+  /// region does not determine every direction (pose_covariance_note says which).
+  std::optional<Mat6> pose_covariance;
+  std::string pose_covariance_note;
 };
+
+/// The covariance above from the inlier pairs: moved source points q, target normals n and the
+/// point-to-plane residuals. Empty (with `note` saying why) for fewer than 7 pairs or a region
+/// that leaves a direction of motion undetermined (a plane, a sphere, a surface of revolution).
+std::optional<Mat6> point_to_plane_pose_covariance(const Points& q, const Points& n, const Eigen::VectorXd& residuals,
+                                                   std::string& note);
 
 /// Aligns `source` (rows are points, e.g. the supine rigid region) to `target` (e.g. the
 /// prone chest ring), starting from `initial`. Normals of both are estimated from
