@@ -16,7 +16,7 @@ WHAT=${2:-all}
 BODIES=${BTR_CAL_BODIES:-8} DRAWS=${BTR_CAL_DRAWS:-3} SAMPLES=${BTR_CAL_SAMPLES:-32} CELL=${BTR_CAL_CELL:-8}
 PRESET=${BTR_CAL_PRESET:-balanced}
 here=$(cd "$(dirname "$0")" && pwd)
-BIN="$here/../build/ws/devel/lib/breast_tumour_registration"
+BIN=${BTR_BIN:-"$here/../build/ws/devel/lib/breast_tumour_registration"}  # BTR_BIN: another build
 mkdir -p "$OUT/phantoms"
 if [ "$WHAT" = phantom ] || [ "$WHAT" = all ]; then
   scenes=()

@@ -16,4 +16,9 @@ Points vertex_normals(const SurfaceMesh& s) {
   return n;
 }
 
+void displace_along_normals(SurfaceMesh& s, double sd, const std::function<double()>& standard_normal) {
+  const Points n = vertex_normals(s);
+  for (Eigen::Index v = 0; v < s.V.rows(); ++v) s.V.row(v) += sd * standard_normal() * n.row(v);
+}
+
 }  // namespace btr

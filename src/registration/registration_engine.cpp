@@ -188,8 +188,8 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     notes.push_back("E not sampled: the stiffness step estimates it from the (sampled) landmarks in every sample");
   const bool sample_noise = src.depth_noise > 0 && scene.supine_surface;
   if (src.depth_noise > 0 && !scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
-  Points normals;
-  if (sample_noise) normals = vertex_normals(*scene.supine_surface);
+  // The camera that sees the skin sees the rigid region too: its noise moves the pose ICP fits.
+  const bool sample_rigid_noise = src.depth_noise > 0 && src.rigid_pose && scene.supine_rigid;
   const std::array<Vec3, 2> axes = gravity_tilt_axes(model.gravity);
   RegistrationOptions o = opt;
   o.uncertainty.enabled = false;
@@ -213,9 +213,9 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     Scene s = scene;
     for (Eigen::Index l = 0; l < s.landmark_supine.rows(); ++l)
       for (int c = 0; c < 3; ++c) s.landmark_supine(l, c) += src.landmark_sd * z(rng);
-    if (sample_noise)
-      for (Eigen::Index v = 0; v < s.supine_surface->V.rows(); ++v)
-        s.supine_surface->V.row(v) += src.depth_noise * z(rng) * normals.row(v);
+    const auto standard_normal = [&] { return z(rng); };
+    if (sample_noise) displace_along_normals(*s.supine_surface, src.depth_noise, standard_normal);
+    if (sample_rigid_noise) displace_along_normals(*s.supine_rigid, src.depth_noise, standard_normal);
     try {  // a sample whose material cannot be unloaded or registered is left out, not the sampling
       RegistrationModel m = model;
       if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);

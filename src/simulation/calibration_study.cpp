@@ -19,23 +19,24 @@ namespace btr {
 namespace {
 
 /// A copy of `s` with the inputs a user cannot know drawn from `src`: the supine landmarks, the
-/// supine surface along its normals, and the method's gravity tilted about two horizontal axes
-/// (returned through `tilt`, the model's gravity rotated the same way).
+/// supine surface along its normals, the method's gravity tilted about two horizontal axes
+/// (returned through `tilt`, the model's gravity rotated the same way), and the supine rigid
+/// region along its normals (so that the pose ICP fits on it is as uncertain as the data make it).
 Scene noisy_copy(const Scene& s, const UncertaintySources& src, std::mt19937& rng, Rigid& tilt) {
   std::normal_distribution<double> z(0.0, 1.0);
   Scene d = s;
   for (Eigen::Index l = 0; l < d.landmark_supine.rows(); ++l)
     for (int c = 0; c < 3; ++c) d.landmark_supine(l, c) += src.landmark_sd * z(rng);
-  if (d.supine_surface && src.depth_noise > 0) {
-    const Points n = vertex_normals(*d.supine_surface);
-    for (Eigen::Index v = 0; v < d.supine_surface->V.rows(); ++v) d.supine_surface->V.row(v) += src.depth_noise * z(rng) * n.row(v);
-  }
+  const auto standard_normal = [&] { return z(rng); };
+  if (d.supine_surface && src.depth_noise > 0) displace_along_normals(*d.supine_surface, src.depth_noise, standard_normal);
   const auto [a0, a1] = gravity_tilt_axes(s.gravity);
   const double sd = src.gravity_direction_deg * M_PI / 180;
   const double t0 = sd * z(rng), t1 = sd * z(rng);
   tilt = Rigid::Identity();
   tilt.linear() = (Eigen::AngleAxisd(t1, a1) * Eigen::AngleAxisd(t0, a0)).toRotationMatrix();
   d.gravity = tilt.linear() * s.gravity;
+  // The rigid region as the same camera sees it (drawn last: the other draws stay as they were).
+  if (d.supine_rigid && src.depth_noise > 0 && src.rigid_pose) displace_along_normals(*d.supine_rigid, src.depth_noise, standard_normal);
   return d;
 }
 

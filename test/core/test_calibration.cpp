@@ -19,8 +19,9 @@ TEST(UncertaintySources, AScenesSectionOverridesTheDefaultsInSIAndBadFieldsAreNa
   const std::string dir = btr::test::coarse_phantom_dir();
   const std::string path = dir + "/uncertainty.yaml";
   write_text(path, scene_text(dir) + "uncertainty: {youngs_modulus_range: [300, 2000], poisson_ratio_range: [0, 0], "
-                                     "landmark_sd_mm: 1, depth_noise_mm: 0.5, gravity_direction_deg: 3}\n");
+                                     "landmark_sd_mm: 1, depth_noise_mm: 0.5, gravity_direction_deg: 3, rigid_pose: false}\n");
   const Scene s = load_scene(path);
+  EXPECT_FALSE(s.uncertainty.rigid_pose);
   EXPECT_EQ(s.uncertainty.youngs_modulus_range[0], 300);
   EXPECT_EQ(s.uncertainty.youngs_modulus_range[1], 2000);
   EXPECT_FALSE(s.uncertainty.samples_poisson_ratio());
@@ -33,6 +34,8 @@ TEST(UncertaintySources, AScenesSectionOverridesTheDefaultsInSIAndBadFieldsAreNa
   EXPECT_EQ(d.uncertainty.youngs_modulus_range[0], 200);
   EXPECT_EQ(d.uncertainty.youngs_modulus_range[1], 3000);
   EXPECT_DOUBLE_EQ(d.uncertainty.landmark_sd, 1.5e-3);
+  EXPECT_TRUE(d.uncertainty.rigid_pose);
+  EXPECT_FALSE(UncertaintySources::none().rigid_pose);
   const auto refused = [&](const std::string& section, const std::string& needle) {
     write_text(path, scene_text(dir) + section);
     expect_throw_with<InputError>([&] { load_scene(path); }, needle);
@@ -44,6 +47,7 @@ TEST(UncertaintySources, AScenesSectionOverridesTheDefaultsInSIAndBadFieldsAreNa
   refused("uncertainty: {depth_noise_mm: -1}\n", "depth_noise_mm");
   refused("uncertainty: {depth_noise_mm: one}\n", "uncertainty.depth_noise_mm");
   refused("uncertainty: 3\n", "field 'uncertainty'");
+  refused("uncertainty: {rigid_pose: maybe}\n", "field 'uncertainty.rigid_pose': expected true or false, got 'maybe'");
 }
 
 TEST(UncertaintySources, ProbabilityWithinASphereIsTheChiSquareCdfAndInvertsTheRadius) {

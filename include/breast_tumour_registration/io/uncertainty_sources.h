@@ -7,7 +7,12 @@
 //     poisson_ratio_range: [0.45, 0.499]   # uniform; [0, 0]: held
 //     gravity_direction_deg: 2             # sd of the tilt about each horizontal axis
 //     landmark_sd_mm: 1.5                  # sd of each supine landmark, per axis
-//     depth_noise_mm: 1                    # sd of the supine surface along its normal
+//     depth_noise_mm: 1                    # sd of the supine surface (and rigid region) along its normal
+//     rigid_pose: true                     # the pose ICP fits on the rigid regions; false: held
+//
+// The rigid pose's distribution is the fit's own: where ICP on the rigid regions sets the pose,
+// the linearisation takes IcpResult::pose_covariance, and sampling re-fits it on the rigid region
+// with depth noise.
 #pragma once
 
 #include <array>
@@ -25,7 +30,10 @@ struct UncertaintySources {
   std::array<double, 2> poisson_ratio_range{0.45, 0.499};
   double gravity_direction_deg = 2.0;  ///< sd of the supine gravity's tilt about each horizontal axis [deg]
   double landmark_sd = 0.0015;         ///< sd of each supine landmark's position, per axis [m] (sampling only)
-  double depth_noise = 0.001;          ///< sd of the supine surface along its normal, per vertex [m]
+  double depth_noise = 0.001;          ///< sd of the supine surface and rigid region along their normals, per vertex [m]
+  /// The rigid pose ICP fits on the rigid regions, as uncertain as its fit (and, sampled, the
+  /// rigid region's depth noise) makes it; false: held at its solution.
+  bool rigid_pose = true;
 
   bool samples_youngs_modulus() const { return youngs_modulus_range[1] > 0; }
   bool samples_poisson_ratio() const { return poisson_ratio_range[1] > 0; }

@@ -56,6 +56,15 @@ struct YamlFields {
       fail(field, "expected a number, got '" + n.as<std::string>() + "'");
     }
   }
+  /// true or false (YAML's spellings of them); anything else is an error naming the field.
+  bool boolean(const YAML::Node& n, const std::string& field) const {
+    if (!n.IsScalar()) fail(field, "expected true or false, not a list or mapping");
+    try {
+      return n.as<bool>();
+    } catch (const YAML::Exception&) {
+      fail(field, "expected true or false, got '" + n.as<std::string>() + "'");
+    }
+  }
   Vec3 vec3(const YAML::Node& n, const std::string& field) const {
     if (!n.IsSequence() || n.size() != 3) fail(field, "expected a list of 3 numbers");
     Vec3 v;
