@@ -248,11 +248,22 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       // alternation contracts quickly).
       SurfaceStepOptions computed = opt.surface;
       if (r.reports.back().sliding_held_from == 0) computed.sliding = SkinSliding::Free;
-      const UncertaintyResult u =
-          linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed, opt.uncertainty);
+      // The pose ICP fitted on the rigid regions is a source, as uncertain as that fit says.
+      std::optional<Mat6> pose_covariance;
+      std::vector<std::string> notes;
+      if (r.icp_used && !r.pose_solved_with_surface && opt.uncertainty.sources.rigid_pose) {
+        pose_covariance = r.icp.pose_covariance;
+        if (!pose_covariance) notes.push_back("the rigid pose is held: " + r.icp.pose_covariance_note);
+      } else if (!r.pose_solved_with_surface && opt.uncertainty.sources.rigid_pose &&
+                 (r.steps.rigid_landmarks || opt.known_supine_to_model)) {
+        notes.push_back(std::string("the rigid pose is held at its solution: it came from ") +
+                        (opt.known_supine_to_model ? "the caller (tracking)" : "the landmarks") +
+                        ", not from ICP on rigid regions, whose fit would say how well it is known");
+      }
+      const UncertaintyResult u = linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed,
+                                                                opt.uncertainty, pose_covariance);
       for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
       r.uncertainty_seconds = u.seconds;
-      std::vector<std::string> notes;
       if (!u.note.empty()) notes.push_back(u.note);
       if (r.pose_solved_with_surface)
         notes.push_back("the rigid pose is held at its solution, but here it is solved with the deformation: on such a "

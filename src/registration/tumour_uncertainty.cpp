@@ -83,7 +83,7 @@ double radius_95(const Mat3& covariance) {
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
-                                                const UncertaintyOptions& opt) {
+                                                const UncertaintyOptions& opt, const std::optional<Mat6>& pose_covariance) {
   std::vector<HeldSkinVertex> held;
   const Mat3 R_p = model_to_projector.linear();
   const Rigid to_model = model_to_projector.inverse();
@@ -92,12 +92,13 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     if (!holds_projection(c, surface)) continue;
     held.push_back({v, to_model * c.point, (R_p.transpose() * c.normal).normalized()});
   }
-  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt);
+  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt, pose_covariance);
 }
 
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
-                                                const SurfaceStepOptions& surface, const UncertaintyOptions& opt) {
+                                                const SurfaceStepOptions& surface, const UncertaintyOptions& opt,
+                                                const std::optional<Mat6>& pose_covariance) {
   validate_uncertainty_options(opt);
   const auto t0 = std::chrono::steady_clock::now();
   UncertaintyResult out;
@@ -113,10 +114,10 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // sliding, a projection that follows the vertex along the surface leaves only the normal
   // direction, with both springs' weight.
   const bool held_along = opt.held_projections || surface.sliding == SkinSliding::HeldWhereSettled;
+  const double w_point = held_along ? surface.point_weight : 0, w_plane = held_along ? surface.plane_weight : spring;
   auto springs = std::make_shared<SpringEnergy>("held skin");
   for (const HeldSkinVertex& h : held)
-    springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, held_along ? surface.point_weight : 0,
-                                 held_along ? surface.plane_weight : spring);
+    springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, w_point, w_plane);
   if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
   TotalEnergy jac;
   for (const auto& t : elastic.terms()) jac.add(t);
@@ -149,6 +150,23 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       for (int v = 0; v < nv; ++v) full.segment<3>(3 * v) = -g.masses()(v) * dg;
       b_g[k] = H.gather(full);
     }
+  }
+  // A rigid motion xi = (omega, tau) of the supine data in the model frame moves each held
+  // target p by omega x p + tau and turns its normal n by omega x n. With r = x_v - p the held
+  // springs' force w_point r + w_plane n (n . r) changes by
+  //   -(w_point dp + w_plane n (n . dp)) + w_plane (dn (n . r) + n (dn . r)).
+  Eigen::VectorXd b_pose[6];
+  for (int k = 0; k < 6; ++k) {
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
+    const Vec3 e = Vec3::Unit(k % 3);
+    for (const HeldSkinVertex& h : held) {
+      const Vec3 dp = k < 3 ? Vec3(e.cross(h.point)) : e;
+      const Vec3 dn = k < 3 ? Vec3(e.cross(h.normal)) : Vec3::Zero();
+      const Vec3 r = x.row(h.vertex).transpose() - h.point;
+      full.segment<3>(3 * h.vertex) +=
+          -(w_point * dp + w_plane * h.normal * h.normal.dot(dp)) + w_plane * (dn * h.normal.dot(r) + h.normal * dn.dot(r));
+    }
+    b_pose[k] = H.gather(full);
   }
   const Mat3 R_s = model_to_supine.linear();
   const double sd_theta = opt.sources.gravity_direction_deg * M_PI / 180.0;
@@ -183,8 +201,18 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       const Vec3 d = R_s * Vec3(spring * lambda.middleRows<3>(3 * f).transpose() * h.normal);
       cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
     }
-    u.covariance = cov_E + cov_g + cov_d;
+    // The rigid pose: the centroid in the model frame moves by dc_m = -lambda^T b, and the moved
+    // pose maps it back, c_s = R_s (c_m + dc_m - omega x c_m - tau).
+    const Vec3 c_m = volume_centroid(s);
+    for (int k = 0; k < 6; ++k) {
+      const Vec3 e = Vec3::Unit(k % 3);
+      const Vec3 moved_back = k < 3 ? Vec3(e.cross(c_m)) : e;
+      u.d_pose.col(k) = R_s * (Vec3(-lambda.transpose() * b_pose[k]) - moved_back);
+    }
+    const Mat3 cov_p = pose_covariance ? Mat3(u.d_pose * *pose_covariance * u.d_pose.transpose()) : Mat3::Zero();
+    u.covariance = cov_E + cov_g + cov_d + cov_p;
     u.sources = {{"youngs_modulus", cov_E}, {"gravity_direction", cov_g}, {"depth_noise", cov_d}};
+    if (pose_covariance) u.sources.emplace_back("rigid_pose", cov_p);
     u.radius_95 = radius_95(u.covariance);
     out.tumours.push_back(u);
   }

@@ -162,6 +162,15 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
         {"overlap", num(r.icp.overlap)},
         {"iterations", r.icp.iterations},
         {"message", r.icp.message}}}};
+  if (r.icp.pose_covariance) {  // how well the fit determines the pose: sd about the model frame's axes
+    const Mat6& c = *r.icp.pose_covariance;
+    j["rigid_transform_supine_to_model"]["icp"]["pose_sd_deg"] = {num(std::sqrt(c(0, 0)) * 180 / M_PI), num(std::sqrt(c(1, 1)) * 180 / M_PI),
+                                                                  num(std::sqrt(c(2, 2)) * 180 / M_PI)};
+    j["rigid_transform_supine_to_model"]["icp"]["pose_sd_mm"] = {num(std::sqrt(c(3, 3)) * 1e3), num(std::sqrt(c(4, 4)) * 1e3),
+                                                                 num(std::sqrt(c(5, 5)) * 1e3)};
+  } else if (!r.icp.pose_covariance_note.empty()) {
+    j["rigid_transform_supine_to_model"]["icp"]["pose_covariance_note"] = r.icp.pose_covariance_note;
+  }
   Json steps = Json::array();
   for (const auto& s : r.reports) steps.push_back(step_report(s));
   j["step_reports"] = steps;
@@ -182,7 +191,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                                 {"poisson_ratio_range", {num(u.poisson_ratio_range[0]), num(u.poisson_ratio_range[1])}},
                                 {"gravity_direction_deg", num(u.gravity_direction_deg)},
                                 {"landmark_sd_mm", num(u.landmark_sd * 1e3)},
-                                {"depth_noise_mm", num(u.depth_noise * 1e3)}};
+                                {"depth_noise_mm", num(u.depth_noise * 1e3)},
+                                {"rigid_pose", u.rigid_pose}};
   }
   j["landmark_residual_mm"] = {{"mean", num(r.landmark_residual_mean * 1e3)}, {"max", num(r.landmark_residual_max * 1e3)}};
   j["skin_to_supine_surface_mm"] = {{"mean", num(r.skin_distance_mean * 1e3)}, {"max", num(r.skin_distance_max * 1e3)}};

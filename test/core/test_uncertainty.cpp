@@ -1,6 +1,8 @@
 // Where the tumour may be (issue 14): the linearised centroid uncertainty against full re-solves.
 #include <algorithm>
 #include <filesystem>
+#include <optional>
+#include <random>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -13,6 +15,7 @@
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/geometry/shapes.h"
+#include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
@@ -110,7 +113,9 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     if (!holds_projection(c, o.surface)) continue;
     held.push_back({v, c.point, c.normal.normalized()});
   }
-  auto resolve = [&](double log_e, const Vec3& gravity) {
+  // move: a rigid motion of the supine data in the model frame (the pose supine -> model becomes
+  // move * T); the centroids come back through that pose.
+  auto resolve = [&](double log_e, const Vec3& gravity, const Rigid& move = Rigid::Identity()) {
     RegistrationModel m = model;
     scale_stiffness(m, std::exp(log_e));
     TotalEnergy energy;
@@ -118,7 +123,8 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     energy.add(std::make_shared<GravityEnergy>(m.rest, m.material.density, gravity));
     auto springs = std::make_shared<SpringEnergy>();
     for (const HeldSkinVertex& k : held)
-      springs->add_point_and_plane(Anchor::vertex(k.vertex), k.point, k.normal, o.surface.point_weight, o.surface.plane_weight);
+      springs->add_point_and_plane(Anchor::vertex(k.vertex), move * k.point, move.linear() * k.normal, o.surface.point_weight,
+                                   o.surface.plane_weight);
     energy.add(springs);
     NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.rest.V.rows()), m.rest.T, m.fixed,
                                                            energy.hessian_cliques()),
@@ -133,7 +139,8 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     // Tolerances far below round-off: a stall at 1e-8 N of a 3 N weight is the minimum too.
     EXPECT_TRUE(nr.converged || nr.gradient_norm < 1e-6) << to_string(nr.reason) << ", gradient " << nr.gradient_norm << " N after " << nr.iterations;
     std::vector<Vec3> c;
-    for (const auto& t : m.tumours) c.push_back(T.inverse() * volume_centroid({apply_embedding(t.embedding, m.rest.T, x), t.prone.F}));
+    for (const auto& t : m.tumours)
+      c.push_back((move * T).inverse() * volume_centroid({apply_embedding(t.embedding, m.rest.T, x), t.prone.F}));
     return std::make_pair(x, c);
   };
   // The balanced result is near, not at, this energy's minimum (its held projections are those
@@ -158,6 +165,63 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     EXPECT_LT((u.d_log_youngs_modulus - fd_e).norm(), 0.03 * fd_e.norm()) << r.tumours[i].name;
     EXPECT_LT((u.d_gravity_tilt[0] - fd_g).norm(), 0.03 * fd_g.norm()) << r.tumours[i].name;
   }
+  // The rigid pose: the supine data turned about a model axis through none of the tumours, and
+  // shifted, by +-h (rad, or h * 1 cm).
+  for (int k : {0, 2, 3, 5}) {
+    const double step = k < 3 ? h : 0.01 * h;
+    auto motion = [&](double sign) {
+      Rigid m = Rigid::Identity();
+      if (k < 3) m.linear() = Eigen::AngleAxisd(sign * step, Vec3::Unit(k)).toRotationMatrix();
+      else m.translation() = sign * step * Vec3::Unit(k - 3);
+      return m;
+    };
+    const auto up = resolve(0, model.gravity, motion(1)).second, down = resolve(0, model.gravity, motion(-1)).second;
+    for (size_t i = 0; i < r.tumours.size(); ++i) {
+      const Vec3 fd = (up[i] - down[i]) / (2 * step), lin_k = lin.tumours[i].d_pose.col(k);
+      std::printf("%-7s dc/dpose[%d] linear (%.4f %.4f %.4f) re-solved (%.4f %.4f %.4f) mm/%s\n", r.tumours[i].name.c_str(), k,
+                  1e3 * lin_k.x(), 1e3 * lin_k.y(), 1e3 * lin_k.z(), 1e3 * fd.x(), 1e3 * fd.y(), 1e3 * fd.z(), k < 3 ? "rad" : "m");
+      EXPECT_LT((lin_k - fd).norm(), 0.03 * fd.norm() + 1e-6) << r.tumours[i].name << " pose " << k;
+    }
+  }
+}
+
+// Where ICP on the rigid regions sets the pose, its fit's covariance is a source of the linear
+// region (and with uncertainty.rigid_pose false it is held); the report states the fit's sd.
+TEST(Uncertainty, TheRigidPoseIsASourceWhereIcpSetsIt) {
+  Scene s = btr::test::coarse_phantom_scene();
+  std::mt19937 rng(11);
+  std::normal_distribution<double> z(0.0, 1.0);
+  displace_along_normals(*s.supine_rigid, 0.001, [&] { return z(rng); });  // the ring as a camera sees it
+  RegistrationOptions o = preset_options("balanced");
+  o.uncertainty.enabled = true;
+  RegistrationEngine engine(s);
+  const RegistrationResult r = engine.solve(o);
+  ASSERT_TRUE(r.icp_used);
+  ASSERT_TRUE(r.icp.pose_covariance) << r.icp.pose_covariance_note;
+  const auto share = [](const TumourUncertainty& u, const std::string& name) {
+    for (const auto& [n, c] : u.sources)
+      if (n == name) return std::optional<Mat3>(c);
+    return std::optional<Mat3>();
+  };
+  for (const auto& t : r.tumours) {
+    const auto pose = share(*t.uncertainty, "rigid_pose");
+    ASSERT_TRUE(pose) << t.name;
+    const Mat3 expected = t.uncertainty->d_pose * *r.icp.pose_covariance * t.uncertainty->d_pose.transpose();
+    EXPECT_LT((*pose - expected).norm(), 1e-12 * expected.norm()) << t.name;
+    EXPECT_GT(pose->trace(), 1e-10) << t.name;  // 1 mm of noise on the ring moves the pose by more than 10 um
+    std::printf("%-7s rigid pose %.2f mm of %.2f mm (RMS)\n", t.name.c_str(), 1e3 * std::sqrt(pose->trace()),
+                1e3 * std::sqrt(t.uncertainty->covariance.trace()));
+  }
+  const std::string d = btr::test::temp_dir();
+  write_registration_outputs(d, engine.prepare(o).scene, engine.prepare(o).model, r, 0);
+  std::ifstream report(d + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(report);
+  const auto& icp = j.at("rigid_transform_supine_to_model").at("icp");
+  ASSERT_EQ(icp.at("pose_sd_deg").size(), 3u);
+  EXPECT_NEAR(icp.at("pose_sd_mm")[2].get<double>(), 1e3 * std::sqrt((*r.icp.pose_covariance)(5, 5)), 1e-9);
+  EXPECT_TRUE(j.at("uncertainty_sources").at("rigid_pose").get<bool>());
+  o.uncertainty.sources.rigid_pose = false;
+  for (const auto& t : engine.solve(o).tumours) EXPECT_FALSE(share(*t.uncertainty, "rigid_pose")) << t.name;
 }
 
 TEST(Uncertainty, OptionsOutOfRangeAreRefusedAndNoSurfaceStepIsSaid) {

@@ -13,10 +13,12 @@
 // Sources (uncertainty_sources.h; independent, Gaussian to first order): the Young's modulus of
 // every tissue together (ln E about the nominal, with the sd of the log-uniform range), the
 // direction of gravity (a tilt about the two horizontal axes), and the supine surface's depth
-// noise (along its normal, per held skin vertex). Not covered by the linearisation: the
+// noise (along its normal, per held skin vertex), and the rigid pose when the fit that set it
+// says how well it did (ICP on the rigid regions: IcpResult::pose_covariance; the supine data
+// move rigidly in the model frame, the chest wall stays). Not covered by the linearisation: the
 // landmarks' localisation and the landmark step's influence on where the surface step ends (it
-// is a start, not an input, of the equilibrium), the rigid pose (held at its solution),
-// Poisson's ratio, and model error beyond these inputs. Sampling (RegistrationEngine::
+// is a start, not an input, of the equilibrium), a pose solved with the landmarks or the skin
+// (held at its solution), Poisson's ratio, and model error beyond these inputs. Sampling (RegistrationEngine::
 // sample_uncertainty) draws every source, the landmarks and Poisson's ratio included.
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
@@ -67,6 +69,10 @@ struct TumourUncertainty {
   /// about the model frame's two horizontal axes [m/rad].
   Vec3 d_log_youngs_modulus = Vec3::Zero();
   Vec3 d_gravity_tilt[2] = {Vec3::Zero(), Vec3::Zero()};
+  /// Per unit of a small rigid motion xi = (omega [rad], tau [m]) of the supine data in the model
+  /// frame (supine -> model becomes exp(xi) of it; IcpResult::pose_covariance): the skin follows
+  /// the moved data, the chest wall stays, and the result is mapped back by the moved pose.
+  Eigen::Matrix<double, 3, 6> d_pose = Eigen::Matrix<double, 3, 6>::Zero();
 };
 
 struct UncertaintyResult {
@@ -86,15 +92,19 @@ struct HeldSkinVertex {
 /// projects the skin first).
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
-                                                const SurfaceStepOptions& surface, const UncertaintyOptions& opt);
+                                                const SurfaceStepOptions& surface, const UncertaintyOptions& opt,
+                                                const std::optional<Mat6>& pose_covariance = std::nullopt);
 
 /// x: the surface step's equilibrium (model frame); supine: the projector it ended on, which
 /// sees the model through model_to_projector; model_to_supine maps the result into the supine
-/// frame. Throws SolverError when the fixed-point Jacobian cannot be factorized.
+/// frame. pose_covariance: that of the rigid pose (supine -> model) as IcpResult::
+/// pose_covariance gives it, a source "rigid_pose"; none: the pose is held. Throws SolverError
+/// when the fixed-point Jacobian cannot be factorized.
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
-                                                const UncertaintyOptions& opt);
+                                                const UncertaintyOptions& opt,
+                                                const std::optional<Mat6>& pose_covariance = std::nullopt);
 
 /// The spread of the registered tumour centroids over whole re-registrations with sampled
 /// inputs (RegistrationEngine::sample_uncertainty): the reference the linearisation is judged by,
