@@ -53,7 +53,11 @@ struct TrackingResult {
   bool motion = false;     ///< the pose moved beyond the motion gate: smoothing restarted
   int smoothed_over = 0;   ///< accepted poses in the mean after this cloud
   bool captured = false;   ///< this cloud ran the capture (wide search) and refinement
-  IcpResult icp;           ///< icp.transform: model -> working frame
+  /// icp.transform: model -> working frame. icp.pose_covariance stays that of the last fit as
+  /// align_icp gave it (a refinement: of working -> model, a motion in the model frame; a
+  /// capture without refinement: of model -> working), for one cloud, not the smoothing
+  /// window's mean; the registration does not use it yet (the tracked pose is held).
+  IcpResult icp;
   long points_in_roi = 0;
   long points_near_region = 0;  ///< after the rigid-region band filter
   double region_coverage = 0;   ///< fraction of the region's 1 cm cells the aligned cloud reaches
