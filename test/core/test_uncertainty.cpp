@@ -165,9 +165,9 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
     EXPECT_LT((u.d_log_youngs_modulus - fd_e).norm(), 0.03 * fd_e.norm()) << r.tumours[i].name;
     EXPECT_LT((u.d_gravity_tilt[0] - fd_g).norm(), 0.03 * fd_g.norm()) << r.tumours[i].name;
   }
-  // The rigid pose: the supine data turned about a model axis through none of the tumours, and
-  // shifted, by +-h (rad, or h * 1 cm).
-  for (int k : {0, 2, 3, 5}) {
+  // The rigid pose: the supine data turned about each model axis and shifted along it, by +-h
+  // (rad, or h * 1 cm).
+  for (int k = 0; k < 6; ++k) {
     const double step = k < 3 ? h : 0.01 * h;
     auto motion = [&](double sign) {
       Rigid m = Rigid::Identity();
