@@ -148,13 +148,31 @@ double DepthTracker::coverage(const Points& near, const Rigid& model_to_working)
   return static_cast<double>(hit.size()) / region_cells_.size();
 }
 
-bool DepthTracker::smooth(const Rigid& latest) {
+std::optional<Mat6> DepthTracker::pose_covariance() const {
+  if (!pose_ || window_covariances_.empty()) return std::nullopt;
+  Mat6 sum = Mat6::Zero();
+  for (const auto& c : window_covariances_) {
+    if (!c) return std::nullopt;
+    sum += *c;
+  }
+  const double n = static_cast<double>(window_covariances_.size());
+  return Mat6(sum / (n * n));  // the mean of n independent poses
+}
+
+bool DepthTracker::smooth(const Rigid& latest, const std::optional<Mat6>& covariance) {
   // A rigid motion's largest displacement over the region is at a corner of its hull, so
   // the bounding-box corners bound it from above.
   const bool restart = pose_ && max_displacement(latest, *pose_, corners_) > opt_.motion_gate;
-  if (restart) window_.clear();
+  if (restart) {
+    window_.clear();
+    window_covariances_.clear();
+  }
   window_.push_back(latest);
-  while (static_cast<int>(window_.size()) > opt_.smoothing_clouds) window_.pop_front();
+  window_covariances_.push_back(covariance);
+  while (static_cast<int>(window_.size()) > opt_.smoothing_clouds) {
+    window_.pop_front();
+    window_covariances_.pop_front();
+  }
   // Mean of the window: translations averaged, rotations by the normalized mean of
   // sign-aligned quaternions (accurate for the small spread of tracking noise).
   const Eigen::Quaterniond q0(window_.front().linear());
@@ -188,6 +206,7 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
   fine.max_correspondence_distance = opt_.max_correspondence;
   fine.min_overlap = opt_.min_overlap;
   Rigid pose = guess_;
+  bool refined = false;  // r.icp is a refinement (working -> model), not the capture
   const auto align_near = [&](double voxel, int iterations) {
     const auto tb = Clock::now();
     const Points near = near_region(finite, pose);
@@ -202,6 +221,7 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
     fine.voxel_size = voxel;
     fine.max_iterations = iterations;
     r.icp = align_icp(near, target_, pose.inverse(), fine);
+    refined = true;
     r.icp.transform = r.icp.transform.inverse();  // working -> model, reported as model -> working
     pose = r.icp.transform;
     r.region_coverage = coverage(near, pose);
@@ -240,8 +260,11 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
   }
   r.accepted = ok;
   if (ok) {
-    if (r.captured) window_.clear();
-    r.motion = smooth(pose);
+    if (r.captured) {
+      window_.clear();
+      window_covariances_.clear();
+    }
+    r.motion = smooth(pose, refined ? r.icp.pose_covariance : std::nullopt);
     r.smoothed_over = static_cast<int>(window_.size());
     latest_ = pose;
     guess_ = pose;
@@ -254,6 +277,7 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
       pose_.reset();
       latest_.reset();
       window_.clear();
+      window_covariances_.clear();
     }
   }
   return r;

@@ -139,6 +139,49 @@ TEST(DepthTracker, CapturesFromALargeOffsetAndSmoothsToSubMillimetre) {
   EXPECT_LT(smoothed, raw[raw.size() / 2]);  // the mean beats a typical single cloud
 }
 
+// The tracked pose's covariance (what the registration takes as the rigid pose's uncertainty):
+// per cloud (a window of one) the pose errors' mean squared Mahalanobis distance under it must be
+// near 6 (chi-square, 6 dof); the window's mean is known better by the window's size.
+TEST(DepthTracker, ThePoseCovarianceMatchesThePoseErrorsOverNoisyClouds) {
+  TrackingScene s;
+  const Rigid truth = make_rigid(Vec3(0, 0, 20), Vec3(0.1, -0.05, 0.75));  // model -> working
+  const int n = 30;
+  std::vector<Points> clouds = s.clouds(truth, n, 5);
+  DepthTrackerOptions o;
+  o.smoothing_clouds = 1;
+  DepthTracker tracker(s.region, truth * make_rigid(Vec3(0, 0, 2), Vec3(0.003, 0, 0)), o);
+  double mahalanobis = 0;
+  int used = 0;
+  for (int i = 0; i < n; ++i) {
+    const TrackingResult r = tracker.process(clouds[i], s.camera_to_world);
+    ASSERT_TRUE(r.accepted) << r.icp.message;
+    const auto cov = tracker.pose_covariance();
+    ASSERT_TRUE(cov.has_value()) << r.icp.pose_covariance_note;
+    if (i == 0) continue;  // the capture's pose
+    const Rigid err = tracker.pose()->inverse() * truth;  // exp(xi) of working -> model: (T' T^-1), T = truth^-1
+    const Eigen::AngleAxisd aa(err.linear());
+    Vec6 xi;
+    xi << aa.angle() * aa.axis(), err.translation();
+    mahalanobis += xi.dot(cov->ldlt().solve(xi));
+    ++used;
+  }
+  mahalanobis /= used;
+  std::printf("tracked pose: mean Mahalanobis %.2f over %d clouds (chi-square 6 dof: 6)\n", mahalanobis, used);
+  EXPECT_GT(mahalanobis, 2.0);
+  EXPECT_LT(mahalanobis, 18.0);
+  // A window of ten: the mean of ten independent clouds' poses.
+  DepthTrackerOptions w;
+  DepthTracker windowed(s.region, truth, w);
+  std::vector<Points> more = s.clouds(truth, 11, 6);
+  std::optional<Mat6> single;
+  for (int i = 0; i < 11; ++i) {
+    ASSERT_TRUE(windowed.process(more[i], s.camera_to_world).accepted);
+    if (i == 0) single = windowed.pose_covariance();  // a window of one: the capture, refined
+  }
+  ASSERT_TRUE(single && windowed.pose_covariance());
+  EXPECT_LT(windowed.pose_covariance()->trace(), 0.3 * single->trace());
+}
+
 TEST(DepthTracker, FollowsAMovingPatientAndRecapturesWhenLost) {
   TrackingScene s;
   const Rigid truth = make_rigid(Vec3(0, 0, 20), Vec3(0.1, -0.05, 0.75));

@@ -55,8 +55,8 @@ struct TrackingResult {
   bool captured = false;   ///< this cloud ran the capture (wide search) and refinement
   /// icp.transform: model -> working frame. icp.pose_covariance stays that of the last fit as
   /// align_icp gave it (a refinement: of working -> model, a motion in the model frame; a
-  /// capture without refinement: of model -> working), for one cloud, not the smoothing
-  /// window's mean; the registration does not use it yet (the tracked pose is held).
+  /// capture without refinement: of model -> working), for one cloud; the smoothed pose's is
+  /// DepthTracker::pose_covariance().
   IcpResult icp;
   long points_in_roi = 0;
   long points_near_region = 0;  ///< after the rigid-region band filter
@@ -102,17 +102,26 @@ class DepthTracker {
   const std::optional<Rigid>& pose() const { return pose_; }
   /// The pose from the last accepted cloud alone.
   const std::optional<Rigid>& latest_pose() const { return latest_; }
+  /// How well pose() is known: the covariance of a small motion xi = (omega [rad], tau [m]) of
+  /// its inverse (working -> model), applied in the model frame, as IcpResult::pose_covariance
+  /// has it (RegistrationOptions::known_pose_covariance takes it so). The refinement fits'
+  /// covariances over the smoothing window, averaged and divided by its size: the clouds' noise
+  /// taken as independent from one cloud to the next. Empty when a pose in the window has none
+  /// (a capture without refinement, a region that leaves a motion undetermined).
+  std::optional<Mat6> pose_covariance() const;
   /// Consecutive accepted clouds (0 after a rejection or a new capture).
   int consecutive() const { return consecutive_; }
 
  private:
   Points near_region(const Points& finite, const Rigid& model_to_working) const;
   double coverage(const Points& near, const Rigid& model_to_working) const;
-  /// Adds an accepted pose to the smoothing window; returns true if it restarted it.
-  bool smooth(const Rigid& latest);
+  /// Adds an accepted pose (and its fit's covariance, if known) to the smoothing window;
+  /// returns true if it restarted it.
+  bool smooth(const Rigid& latest, const std::optional<Mat6>& covariance);
   SurfaceSamples region_;
   Points corners_;  // corners of the region's bounding box (motion gate)
   std::deque<Rigid> window_;
+  std::deque<std::optional<Mat6>> window_covariances_;  // as window_
   std::optional<Rigid> latest_;
   IcpTarget target_;
   std::vector<long long> region_voxels_;  // sorted keys of the dilated rigid-region voxels
