@@ -9,7 +9,7 @@
 namespace btr {
 
 LiveScene live_scene(const Scene& prepared, const LiveScan& scan, const LiveSceneOptions& opt) {
-  LiveScene live{prepared, scan.supine_to_working.inverse()};
+  LiveScene live{prepared, scan.supine_to_working.inverse(), scan.pose_covariance};
   Scene& s = live.scene;
   if (scan.width > 0) {
     const double noise = is_organized(scan.cloud, scan.width, scan.height) ? estimate_organized_noise(scan.cloud, scan.width, scan.height, opt.max_depth_edge)

@@ -1,5 +1,6 @@
 #include "breast_tumour_registration/registration/registration_engine.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -143,6 +144,7 @@ RegistrationResult RegistrationEngine::solve_live(const LiveScan& scan, const Li
   LiveScene ls = live_scene(e.prepared.scene, scan, live);
   ls.scene.preset = opt.preset;
   opt.known_supine_to_model = ls.known_supine_to_model;
+  opt.known_pose_covariance = ls.known_pose_covariance;
   return run(e, ls.scene, opt, callback);
 }
 
@@ -161,6 +163,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty_live(const LiveScan& s
   LiveScene ls = live_scene(e.prepared.scene, scan, live);
   ls.scene.preset = opt.preset;
   opt.known_supine_to_model = ls.known_supine_to_model;
+  opt.known_pose_covariance = ls.known_pose_covariance;
   return sample(e, ls.scene, opt, sources, samples, seed, nominal);
 }
 
@@ -190,6 +193,13 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   if (src.depth_noise > 0 && !scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
   // The camera that sees the skin sees the rigid region too: its noise moves the pose ICP fits.
   const bool sample_rigid_noise = src.depth_noise > 0 && src.rigid_pose && scene.supine_rigid;
+  // A pose given with its covariance (tracking) is drawn from it: exp(L z) applied after it.
+  const bool sample_known_pose = src.rigid_pose && opt.known_supine_to_model && opt.known_pose_covariance;
+  Mat6 pose_factor = Mat6::Zero();
+  if (sample_known_pose) {
+    const Eigen::SelfAdjointEigenSolver<Mat6> es(*opt.known_pose_covariance);
+    pose_factor = es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  }
   const std::array<Vec3, 2> axes = gravity_tilt_axes(model.gravity);
   RegistrationOptions o = opt;
   o.uncertainty.enabled = false;
@@ -216,6 +226,16 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     const auto standard_normal = [&] { return z(rng); };
     if (sample_noise) displace_along_normals(*s.supine_surface, src.depth_noise, standard_normal);
     if (sample_rigid_noise) displace_along_normals(*s.supine_rigid, src.depth_noise, standard_normal);
+    RegistrationOptions os = o;
+    if (sample_known_pose) {
+      Vec6 u;
+      for (int k = 0; k < 6; ++k) u(k) = z(rng);
+      const Vec6 xi = pose_factor * u;
+      Rigid move = Rigid::Identity();
+      if (xi.head<3>().norm() > 0) move.linear() = Eigen::AngleAxisd(xi.head<3>().norm(), xi.head<3>().normalized()).toRotationMatrix();
+      move.translation() = xi.tail<3>();
+      os.known_supine_to_model = move * *opt.known_supine_to_model;
+    }
     try {  // a sample whose material cannot be unloaded or registered is left out, not the sampling
       RegistrationModel m = model;
       if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);
@@ -226,7 +246,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
         unload_kept_prone += !u.note.empty() && u.unload.rest_change == 0;
       }
       m.gravity = Eigen::AngleAxisd(tilt[1], axes[1]) * (Eigen::AngleAxisd(tilt[0], axes[0]) * model.gravity);
-      const RegistrationResult r = run_registration(s, m, o, {}, &e.solvers);
+      const RegistrationResult r = run_registration(s, m, os, {}, &e.solvers);
       ++out.samples;
       if (!r.converged) {
         ++out.not_converged;

@@ -251,14 +251,16 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       // The pose ICP fitted on the rigid regions is a source, as uncertain as that fit says.
       std::optional<Mat6> pose_covariance;
       std::vector<std::string> notes;
-      if (r.icp_used && !r.pose_solved_with_surface && opt.uncertainty.sources.rigid_pose) {
+      if (opt.known_supine_to_model && opt.uncertainty.sources.rigid_pose) {
+        pose_covariance = opt.known_pose_covariance;
+        if (!pose_covariance)
+          notes.push_back("the rigid pose is held: the caller (tracking) gave it without a covariance");
+      } else if (r.icp_used && !r.pose_solved_with_surface && opt.uncertainty.sources.rigid_pose) {
         pose_covariance = r.icp.pose_covariance;
         if (!pose_covariance) notes.push_back("the rigid pose is held: " + r.icp.pose_covariance_note);
-      } else if (!r.pose_solved_with_surface && opt.uncertainty.sources.rigid_pose &&
-                 (r.steps.rigid_landmarks || opt.known_supine_to_model)) {
-        notes.push_back(std::string("the rigid pose is held at its solution: it came from ") +
-                        (opt.known_supine_to_model ? "the caller (tracking)" : "the landmarks") +
-                        ", not from ICP on rigid regions, whose fit would say how well it is known");
+      } else if (!r.pose_solved_with_surface && opt.uncertainty.sources.rigid_pose && r.steps.rigid_landmarks) {
+        notes.push_back("the rigid pose is held at its solution: it came from the landmarks, not from ICP on rigid "
+                        "regions, whose fit would say how well it is known");
       }
       const UncertaintyResult u = linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed,
                                                                 opt.uncertainty, pose_covariance);

@@ -283,6 +283,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       Points cloud;
       int w, h;
       std::optional<Rigid> T;
+      std::optional<Mat6> T_covariance;
       int tracked = 0;
       {
         std::lock_guard<std::mutex> lock(state_mutex_);
@@ -294,6 +295,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
         h = latest_height_;
         if (tracker_) {
           T = tracker_->pose();
+          T_covariance = tracker_->pose_covariance();
           tracked = tracker_->consecutive();
         }
       }
@@ -306,7 +308,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       lo.max_depth_edge = params_.max_depth_edge;
       lo.smoothing_pixels = params_.scan_smoothing_pixels;
       lo.use_landmarks = params_.use_landmarks;
-      scan = LiveScan{std::move(cloud), w, h, *T};
+      scan = LiveScan{std::move(cloud), w, h, *T, T_covariance};
     }
     publish_status(diagnostic_msgs::DiagnosticStatus::OK, "registration running (" + preset + ")");
     struct Flag {

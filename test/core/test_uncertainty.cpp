@@ -1,5 +1,6 @@
 // Where the tumour may be (issue 14): the linearised centroid uncertainty against full re-solves.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <random>
@@ -222,6 +223,41 @@ TEST(Uncertainty, TheRigidPoseIsASourceWhereIcpSetsIt) {
   EXPECT_TRUE(j.at("uncertainty_sources").at("rigid_pose").get<bool>());
   o.uncertainty.sources.rigid_pose = false;
   for (const auto& t : engine.solve(o).tumours) EXPECT_FALSE(share(*t.uncertainty, "rigid_pose")) << t.name;
+}
+
+// A pose given by the caller (the node's tracking) with its covariance: the linear region takes
+// it, sampling draws the pose from it, and the two agree where the response is nearly linear;
+// without a covariance the note says the pose is held.
+TEST(Uncertainty, AGivenPoseWithItsCovarianceIsLinearisedAndSampled) {
+  const Scene& s = btr::test::coarse_phantom_scene();
+  RegistrationOptions o = preset_options("accurate");
+  o.uncertainty.enabled = true;
+  o.uncertainty.sources = UncertaintySources::none();
+  o.uncertainty.sources.rigid_pose = true;
+  RegistrationEngine engine(s);
+  o.known_supine_to_model = engine.solve(o).supine_to_model;  // as a tracker would have it
+  const RegistrationResult held = engine.solve(o);
+  EXPECT_NE(held.uncertainty_note.find("held: the caller (tracking) gave it without a covariance"), std::string::npos)
+      << held.uncertainty_note;
+  Mat6 cov = Mat6::Zero();
+  cov.diagonal() << std::pow(0.3 * M_PI / 180, 2), std::pow(0.3 * M_PI / 180, 2), std::pow(0.5 * M_PI / 180, 2), 0.3e-6,
+      0.3e-6, 0.5e-6;  // 0.3 / 0.3 / 0.5 deg, 0.55 / 0.55 / 0.71 mm
+  o.known_pose_covariance = cov;
+  const RegistrationResult r = engine.solve(o);
+  ASSERT_TRUE(r.converged);
+  EXPECT_TRUE(r.uncertainty_note.empty()) << r.uncertainty_note;
+  const SampledUncertainty su = engine.sample_uncertainty(o, o.uncertainty, 24, 9, r);
+  ASSERT_EQ(su.samples, 24);
+  for (size_t i = 0; i < r.tumours.size(); ++i) {
+    const TumourUncertainty& u = *r.tumours[i].uncertainty;
+    ASSERT_EQ(u.sources.size(), 4u);
+    EXPECT_EQ(u.sources.back().first, "rigid_pose");
+    const double linear = std::sqrt(u.covariance.trace()), sampled = std::sqrt(su.tumours[i].covariance.trace());
+    std::printf("%-7s pose alone: RMS spread linear %.3f mm, sampled %.3f mm (24 samples), ratio %.2f\n",
+                r.tumours[i].name.c_str(), 1e3 * linear, 1e3 * sampled, linear / sampled);
+    EXPECT_GT(linear / sampled, 0.6) << r.tumours[i].name;
+    EXPECT_LT(linear / sampled, 1.6) << r.tumours[i].name;
+  }
 }
 
 TEST(Uncertainty, OptionsOutOfRangeAreRefusedAndNoSurfaceStepIsSaid) {

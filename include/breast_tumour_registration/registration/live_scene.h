@@ -3,6 +3,8 @@
 // a core function (tested without ROS).
 #pragma once
 
+#include <optional>
+
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/io/scene.h"
 
@@ -12,6 +14,9 @@ struct LiveScan {
   Points cloud;           ///< working frame [m]; organized (width * height rows, NaN = no data) or not (width 0)
   int width = 0, height = 0;
   Rigid supine_to_working = Rigid::Identity();  ///< the tracked alignment of the scene's supine frame
+  /// How well that alignment is known (DepthTracker::pose_covariance: a motion of its inverse in
+  /// the scene's frame); empty: held.
+  std::optional<Mat6> pose_covariance;
 };
 
 struct LiveSceneOptions {
@@ -29,6 +34,7 @@ struct LiveSceneOptions {
 struct LiveScene {
   Scene scene;                  ///< supine side in the working frame; automatic steps
   Rigid known_supine_to_model;  ///< for RegistrationOptions::known_supine_to_model: the tracked pose decides
+  std::optional<Mat6> known_pose_covariance;  ///< for RegistrationOptions::known_pose_covariance (the scan's)
   double estimated_noise = 0;   ///< [m] an organized scan's estimated depth noise (0: not organized)
   bool smoothed = false;        ///< the scan was smoothed before triangulation
 };

@@ -32,6 +32,11 @@ struct RegistrationOptions {
   /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
   /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
   std::optional<Rigid> known_supine_to_model;
+  /// How well known_supine_to_model is known: the covariance of a small motion xi = (omega
+  /// [rad], tau [m]) applied after it in the model frame (IcpResult::pose_covariance's
+  /// convention). The linear region takes it as the source rigid_pose and sampling draws the
+  /// pose from it; empty: the pose is held.
+  std::optional<Mat6> known_pose_covariance;
   /// [m] When ICP on the rigid regions decides the pose and the pose solved jointly with the
   /// landmarks moves the rigid region by more than this, the result carries a warning.
   double pose_disagreement_warning = 0.003;
