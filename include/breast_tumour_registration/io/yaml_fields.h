@@ -48,23 +48,20 @@ struct YamlFields {
   /// maps in a list, and "a.*" for a free-form mapping. An unknown key is an error that names
   /// the nearest valid key ("did you mean prone.cell_size_mm?").
   void check_keys(const YAML::Node& root, const std::vector<std::string>& valid) const;
-  double number(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) fail(field, "expected a number, not a list or mapping");
+  /// A scalar read as T; a list or mapping, or a value that is not a T, is an error naming the
+  /// field and what was expected.
+  template <class T>
+  T scalar(const YAML::Node& n, const std::string& field, const std::string& expected) const {
+    if (!n.IsScalar()) fail(field, "expected " + expected + ", not a list or mapping");
     try {
-      return n.as<double>();
+      return n.as<T>();
     } catch (const YAML::Exception&) {
-      fail(field, "expected a number, got '" + n.as<std::string>() + "'");
+      fail(field, "expected " + expected + ", got '" + n.as<std::string>() + "'");
     }
   }
+  double number(const YAML::Node& n, const std::string& field) const { return scalar<double>(n, field, "a number"); }
   /// true or false (YAML's spellings of them); anything else is an error naming the field.
-  bool boolean(const YAML::Node& n, const std::string& field) const {
-    if (!n.IsScalar()) fail(field, "expected true or false, not a list or mapping");
-    try {
-      return n.as<bool>();
-    } catch (const YAML::Exception&) {
-      fail(field, "expected true or false, got '" + n.as<std::string>() + "'");
-    }
-  }
+  bool boolean(const YAML::Node& n, const std::string& field) const { return scalar<bool>(n, field, "true or false"); }
   Vec3 vec3(const YAML::Node& n, const std::string& field) const {
     if (!n.IsSequence() || n.size() != 3) fail(field, "expected a list of 3 numbers");
     Vec3 v;
