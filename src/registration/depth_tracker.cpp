@@ -149,13 +149,13 @@ double DepthTracker::coverage(const Points& near, const Rigid& model_to_working)
 }
 
 std::optional<Mat6> DepthTracker::pose_covariance() const {
-  if (!pose_ || window_covariances_.empty()) return std::nullopt;
+  if (!pose_ || window_.empty()) return std::nullopt;
   Mat6 sum = Mat6::Zero();
-  for (const auto& c : window_covariances_) {
-    if (!c) return std::nullopt;
-    sum += *c;
+  for (const WindowPose& w : window_) {
+    if (!w.covariance) return std::nullopt;
+    sum += *w.covariance;
   }
-  const double n = static_cast<double>(window_covariances_.size());
+  const double n = static_cast<double>(window_.size());
   return Mat6(sum / (n * n));  // the mean of n independent poses
 }
 
@@ -163,22 +163,16 @@ bool DepthTracker::smooth(const Rigid& latest, const std::optional<Mat6>& covari
   // A rigid motion's largest displacement over the region is at a corner of its hull, so
   // the bounding-box corners bound it from above.
   const bool restart = pose_ && max_displacement(latest, *pose_, corners_) > opt_.motion_gate;
-  if (restart) {
-    window_.clear();
-    window_covariances_.clear();
-  }
-  window_.push_back(latest);
-  window_covariances_.push_back(covariance);
-  while (static_cast<int>(window_.size()) > opt_.smoothing_clouds) {
-    window_.pop_front();
-    window_covariances_.pop_front();
-  }
+  if (restart) window_.clear();
+  window_.push_back({latest, covariance});
+  while (static_cast<int>(window_.size()) > opt_.smoothing_clouds) window_.pop_front();
   // Mean of the window: translations averaged, rotations by the normalized mean of
   // sign-aligned quaternions (accurate for the small spread of tracking noise).
-  const Eigen::Quaterniond q0(window_.front().linear());
+  const Eigen::Quaterniond q0(window_.front().pose.linear());
   Eigen::Vector4d q = Eigen::Vector4d::Zero();
   Vec3 t = Vec3::Zero();
-  for (const Rigid& T : window_) {
+  for (const WindowPose& w : window_) {
+    const Rigid& T = w.pose;
     const Eigen::Quaterniond qi(T.linear());
     q += (qi.dot(q0) < 0 ? -1.0 : 1.0) * qi.coeffs();
     t += T.translation();
@@ -260,10 +254,7 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
   }
   r.accepted = ok;
   if (ok) {
-    if (r.captured) {
-      window_.clear();
-      window_covariances_.clear();
-    }
+    if (r.captured) window_.clear();
     r.motion = smooth(pose, refined ? r.icp.pose_covariance : std::nullopt);
     r.smoothed_over = static_cast<int>(window_.size());
     latest_ = pose;
@@ -277,7 +268,6 @@ TrackingResult DepthTracker::process(Points& cloud, const Rigid& sensor_to_worki
       pose_.reset();
       latest_.reset();
       window_.clear();
-      window_covariances_.clear();
     }
   }
   return r;

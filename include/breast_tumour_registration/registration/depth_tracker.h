@@ -120,8 +120,11 @@ class DepthTracker {
   bool smooth(const Rigid& latest, const std::optional<Mat6>& covariance);
   SurfaceSamples region_;
   Points corners_;  // corners of the region's bounding box (motion gate)
-  std::deque<Rigid> window_;
-  std::deque<std::optional<Mat6>> window_covariances_;  // as window_
+  struct WindowPose {
+    Rigid pose;
+    std::optional<Mat6> covariance;  // of its fit, if known
+  };
+  std::deque<WindowPose> window_;
   std::optional<Rigid> latest_;
   IcpTarget target_;
   std::vector<long long> region_voxels_;  // sorted keys of the dilated rigid-region voxels
