@@ -61,4 +61,19 @@ double max_displacement(const Rigid& A, const Rigid& B, const Points& P) {
   return worst;
 }
 
+Rigid rigid_from_motion(const Vec6& xi) {
+  Rigid T = Rigid::Identity();
+  const double angle = xi.head<3>().norm();
+  if (angle > 0) T.linear() = Eigen::AngleAxisd(angle, xi.head<3>() / angle).toRotationMatrix();
+  T.translation() = xi.tail<3>();
+  return T;
+}
+
+Vec6 motion_of(const Rigid& T) {
+  const Eigen::AngleAxisd aa(T.linear());
+  Vec6 xi;
+  xi << aa.angle() * aa.axis(), T.translation();
+  return xi;
+}
+
 }  // namespace btr

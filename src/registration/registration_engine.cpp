@@ -230,11 +230,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     if (sample_known_pose) {
       Vec6 u;
       for (int k = 0; k < 6; ++k) u(k) = z(rng);
-      const Vec6 xi = pose_factor * u;
-      Rigid move = Rigid::Identity();
-      if (xi.head<3>().norm() > 0) move.linear() = Eigen::AngleAxisd(xi.head<3>().norm(), xi.head<3>().normalized()).toRotationMatrix();
-      move.translation() = xi.tail<3>();
-      os.known_supine_to_model = move * *opt.known_supine_to_model;
+      os.known_supine_to_model = rigid_from_motion(pose_factor * u) * *opt.known_supine_to_model;
     }
     try {  // a sample whose material cannot be unloaded or registered is left out, not the sampling
       RegistrationModel m = model;

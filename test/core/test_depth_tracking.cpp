@@ -159,9 +159,7 @@ TEST(DepthTracker, ThePoseCovarianceMatchesThePoseErrorsOverNoisyClouds) {
     ASSERT_TRUE(cov.has_value()) << r.icp.pose_covariance_note;
     if (i == 0) continue;  // the capture's pose
     const Rigid err = tracker.pose()->inverse() * truth;  // exp(xi) of working -> model: (T' T^-1), T = truth^-1
-    const Eigen::AngleAxisd aa(err.linear());
-    Vec6 xi;
-    xi << aa.angle() * aa.axis(), err.translation();
+    const Vec6 xi = motion_of(err);
     mahalanobis += xi.dot(cov->ldlt().solve(xi));
     ++used;
   }

@@ -134,9 +134,7 @@ TEST(Icp, PoseCovarianceMatchesTheSpreadOverNoisyScans) {
     ASSERT_TRUE(r.accepted) << r.message;
     ASSERT_TRUE(r.pose_covariance.has_value()) << r.pose_covariance_note;
     const Rigid err = r.transform * T.inverse();  // exp(xi)
-    const Eigen::AngleAxisd aa(err.linear());
-    Vec6 xi;
-    xi << aa.angle() * aa.axis(), err.translation();
+    const Vec6 xi = motion_of(err);
     mahalanobis += xi.dot(r.pose_covariance->ldlt().solve(xi)) / draws;
     sd_rotation_deg += std::sqrt(r.pose_covariance->topLeftCorner<3, 3>().trace()) * 180 / M_PI / draws;
   }

@@ -25,6 +25,12 @@ double rotation_angle(const Rigid& T);
 /// (roll_pitch_yaw [rad], fixed axes X then Y then Z; ROS's RPY convention).
 Rigid rigid_from_rpy(const Vec3& translation, const Vec3& roll_pitch_yaw);
 
+/// A motion xi = (omega [rad], tau [m]) as a transform: p -> R(omega) p + tau, R(omega) the
+/// rotation by |omega| about omega (for the small motions of a pose's uncertainty, where this
+/// is exp(xi) to first order); motion_of is its inverse.
+Rigid rigid_from_motion(const Vec6& xi);
+Vec6 motion_of(const Rigid& T);
+
 /// Largest distance between A p and B p over the rows p of P [m]; 0 for no rows.
 double max_displacement(const Rigid& A, const Rigid& B, const Points& P);
 
