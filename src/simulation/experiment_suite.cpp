@@ -237,6 +237,10 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
   }
   const std::vector<double>& moduli = opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli;
   const RegistrationOptions preset = preset_options(opt.preset);
+  if (opt.given_configurations)
+    for (double e : moduli)
+      if (!opt.given_configurations->count(e))
+        throw InputError("generating Young's modulus " + format_value(e) + " Pa: the given truth has no configuration for it");
   // This share of the (modulus, run) items, in plan order.
   const ShardRange share = shard_range(moduli.size() * todo.size(), opt.shard, opt.shards);
   for (size_t ei = 0; ei < moduli.size(); ++ei) {
@@ -250,14 +254,19 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
     const auto t0 = std::chrono::steady_clock::now();
     PhantomConfigurations conf;
     std::string generation_failure;
-    try {
-      conf = simulate_phantom(model, gen);
-    } catch (const std::exception& err) {
-      generation_failure = std::string("failed: generating the configurations: ") + err.what();
+    if (opt.given_configurations) {
+      conf = opt.given_configurations->at(e);
+      say("given configuration for E = " + format_value(e) + " Pa");
+    } else {
+      try {
+        conf = simulate_phantom(model, gen);
+      } catch (const std::exception& err) {
+        generation_failure = std::string("failed: generating the configurations: ") + err.what();
+      }
+      say("generated E = " + format_value(e) + " Pa in " +
+          format_value(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) + " s" +
+          (generation_failure.empty() ? "" : " (" + generation_failure + ")"));
     }
-    say("generated E = " + format_value(e) + " Pa in " +
-        format_value(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) + " s" +
-        (generation_failure.empty() ? "" : " (" + generation_failure + ")"));
     std::map<double, std::pair<Points, StepReport>> unloaded;  // per method Young's modulus, this configuration
     for (size_t ri = 0; ri < todo.size(); ++ri) {
       if (first_item + ri < share.first || first_item + ri >= share.last) continue;

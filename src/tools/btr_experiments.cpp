@@ -14,6 +14,7 @@
 #include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/simulation/experiment_shards.h"
 #include "breast_tumour_registration/simulation/experiment_suite.h"
+#include "breast_tumour_registration/simulation/given_truth_io.h"
 #include "breast_tumour_registration/simulation/rest_model_io.h"
 
 namespace fs = std::filesystem;
@@ -36,6 +37,12 @@ int main(int argc, char** argv) {
   app.add_option("-E,--youngs-moduli", moduli, "generating Young's moduli [Pa] (default: the thesis's 16, 200-12000)")
       ->check(btr::cli::positive());
   app.add_option("--model", model_path, "a rest model file (YAML, see rest_model_io.h) instead of the built-in phantom");
+  std::string truth_path;
+  app.add_option("--truth", truth_path,
+                 "with --model: a truth file (YAML, see given_truth_io.h) of prone and supine configurations made "
+                 "elsewhere (another FEM code), run instead of generating them; -E picks among its moduli (default: "
+                 "all of them)")
+      ->needs(app.get_option("--model"));
   app.add_option("--cell-size", cell_mm, "built-in phantom: tetrahedron size bound [mm] (8: ~6k tets, 4.7: ~35k)")
       ->capture_default_str();
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
@@ -82,15 +89,24 @@ int main(int argc, char** argv) {
     if (!model_path.empty()) {
       model = load_rest_model(model_path);
       for (const auto& w : model.warnings) std::printf("[experiments] warning: %s\n", w.c_str());
+      if (!truth_path.empty()) {
+        opt.given_configurations = std::make_shared<const std::map<double, PhantomConfigurations>>(
+            load_given_configurations(truth_path, model));
+        if (moduli.empty()) {  // every configuration of the truth (--quick's two moduli are the phantom's)
+          opt.generating_youngs_moduli.clear();
+          for (const auto& [e, conf] : *opt.given_configurations) opt.generating_youngs_moduli.push_back(e);
+        }
+      }
     } else {
       PhantomOptions po;
       po.tet.cell_size = cell_mm * 1e-3;
       model = make_phantom_model(po);
     }
     const size_t n_moduli = opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli().size() : opt.generating_youngs_moduli.size();
-    std::printf("[experiments] %s: %ld vertices, %ld tetrahedra, %zu tumours, %zu landmarks; %zu runs x %zu generating "
+    std::printf("[experiments] %s%s: %ld vertices, %ld tetrahedra, %zu tumours, %zu landmarks; %zu runs x %zu generating "
                 "moduli, preset %s\n",
-                model_path.empty() ? "built-in phantom" : model_path.c_str(), static_cast<long>(model.rest.V.rows()),
+                model_path.empty() ? "built-in phantom" : model_path.c_str(),
+                truth_path.empty() ? "" : (" with the configurations of " + truth_path).c_str(), static_cast<long>(model.rest.V.rows()),
                 static_cast<long>(model.rest.T.rows()), model.tumours.size(), model.landmarks.size(), runs.size(), n_moduli,
                 preset.c_str());
     std::fflush(stdout);

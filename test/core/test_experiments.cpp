@@ -15,9 +15,11 @@
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/io/index_io.h"
+#include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/simulation/experiment_shards.h"
 #include "breast_tumour_registration/simulation/experiment_suite.h"
+#include "breast_tumour_registration/simulation/given_truth_io.h"
 #include "breast_tumour_registration/simulation/rest_model_io.h"
 #include "test_util.h"
 
@@ -171,6 +173,116 @@ TEST(ExperimentSuite, ModelWithGravityAlongXMatchesTheSameBodyAlongZ) {
   EXPECT_LT(along_x.max("practical/full/method=full"), 0.5);
   EXPECT_NEAR(along_x.max("practical/full/method=full"), along_z.max("practical/full/method=full"), 0.05);
   EXPECT_NEAR(along_x.max("practical/rigid/method=rigid"), along_z.max("practical/rigid/method=rigid"), 0.05);
+}
+
+// Writes `conf` as a truth file's configuration (the files bench/make_independent_truth.py
+// writes for SfePy's solutions) and returns its YAML list item.
+std::string write_configuration(const std::string& dir, const std::string& tag, const PhantomModel& model,
+                                const PhantomConfigurations& conf) {
+  TetMesh volume = model.rest;
+  std::string item = "  - youngs_modulus: " + tag + "\n";
+  const std::vector<std::pair<std::string, const Points*>> poses = {{"prone", &conf.prone}, {"supine", &conf.supine}};
+  for (const auto& [pose, V] : poses) {
+    volume.V = *V;
+    write_tet_mesh(dir + "/" + tag + "_" + pose + ".vtk", volume, LengthUnit::Millimetre);
+    item += "    " + pose + ": " + tag + "_" + pose + ".vtk\n";
+  }
+  item += "    tumours:\n";
+  for (const auto& [name, t] : conf.tumour_prone) {
+    write_surface(dir + "/" + tag + "_" + name + "_prone.obj", t, LengthUnit::Millimetre);
+    write_surface(dir + "/" + tag + "_" + name + "_supine.obj", conf.tumour_supine.at(name), LengthUnit::Millimetre);
+    item += "      " + name + ": {prone: " + tag + "_" + name + "_prone.obj, supine: " + tag + "_" + name + "_supine.obj}\n";
+  }
+  return item;
+}
+
+// The suite on configurations made elsewhere (issue 13: truth from an independent FEM code):
+// given the configurations its own solver makes, it must give the rows it gives when it makes
+// them; given another body's (a stiff gland it does not model), it runs on those.
+TEST(ExperimentSuite, RunsOnConfigurationsMadeElsewhere) {
+  const std::string dir = test::temp_dir();
+  write_rest_model(dir, coarse_phantom(), LengthUnit::Millimetre);
+  const PhantomModel m = load_rest_model(dir + "/model.yaml");
+  PhantomSceneOptions gen;
+  gen.youngs_modulus = 4000;
+  const PhantomConfigurations own = simulate_phantom(m, gen);
+  gen.gland_youngs_modulus = 4 * gen.youngs_modulus;  // heterogeneous: not what the method assumes
+  const PhantomConfigurations other = simulate_phantom(coarse_phantom(), gen);  // the file's model has no gland
+  test::write_text(dir + "/truth.yaml", "units: mm\nconfigurations:\n" + write_configuration(dir, "4000", m, own) +
+                                            write_configuration(dir, "1000", m, other));
+  const auto given = std::make_shared<const std::map<double, PhantomConfigurations>>(
+      load_given_configurations(dir + "/truth.yaml", m));
+  ASSERT_EQ(given->size(), 2u);
+  EXPECT_NEAR((given->at(4000).supine - own.supine).cwiseAbs().maxCoeff(), 0, 1e-9);
+  EXPECT_NEAR((given->at(4000).tumour_supine.at("top").V - own.tumour_supine.at("top").V).cwiseAbs().maxCoeff(), 0, 1e-9);
+
+  ExperimentSuiteOptions o;
+  o.experiments = {"practical"};
+  o.generating_youngs_moduli = {4000};
+  std::map<std::string, double> generated, read;
+  const auto key = [](const ExperimentRow& r) { return r.run->setting + "/" + r.tumour; };
+  run_experiments(m, o, plan_experiments(o), [&](const ExperimentRow& r) { generated[key(r)] = r.centroid_distance_mm; });
+  o.given_configurations = given;
+  std::vector<std::string> said;
+  run_experiments(m, o, plan_experiments(o), [&](const ExperimentRow& r) { read[key(r)] = r.centroid_distance_mm; },
+                  [&](const std::string& l) { said.push_back(l); });
+  ASSERT_EQ(read.size(), 25u);
+  for (const auto& [k, d] : generated) EXPECT_NEAR(read.at(k), d, 1e-3) << k;
+  EXPECT_EQ(said.front(), "given configuration for E = 4000 Pa");
+
+  // The other body: the rows say E = 1000 (the modulus it stands for) and the full method still
+  // beats rigid alignment, though the truth's stiff gland is not in the model.
+  o.generating_youngs_moduli = {1000};
+  Summary s;
+  run_experiments(m, o, plan_experiments(o), [&](const ExperimentRow& r) {
+    s.add(r);
+    EXPECT_EQ(r.generating_youngs_modulus, 1000);
+  });
+  EXPECT_EQ(s.rows, 25);
+  EXPECT_LT(s.max("practical/full/method=full"), s.min("practical/rigid/method=rigid"));
+  o.generating_youngs_moduli = {2000};
+  test::expect_throw_with<InputError>([&] { run_experiments(m, o, plan_experiments(o), [](const ExperimentRow&) {}); },
+                                      "modulus 2000 Pa: the given truth has no configuration for it");
+}
+
+TEST(GivenTruthErrors, NameTheFieldAtFault) {
+  const std::string dir = test::temp_dir();
+  write_rest_model(dir, coarse_phantom(), LengthUnit::Millimetre);
+  const PhantomModel m = load_rest_model(dir + "/model.yaml");
+  PhantomConfigurations conf;
+  conf.prone = conf.supine = m.rest.V;
+  conf.tumour_prone = conf.tumour_supine = m.tumours;
+  const std::string item = write_configuration(dir, "900", m, conf);
+  auto truth = [&](const std::string& yaml) {
+    test::write_text(dir + "/bad.yaml", yaml);
+    return dir + "/bad.yaml";
+  };
+  EXPECT_EQ(load_given_configurations(truth("units: mm\nconfigurations:\n" + item), m).size(), 1u);
+  test::expect_throw_with<InputError>([&] { load_given_configurations(truth("configurations:\n" + item), m); },
+                                      "field 'units': missing");
+  test::expect_throw_with<InputError>(
+      [&] { load_given_configurations(truth("units: mm\nconfigurations:\n" + item + item), m); },
+      "field 'configurations[1].youngs_modulus': given twice");
+  test::expect_throw_with<InputError>(
+      [&] { load_given_configurations(truth("units: mm\nconfiguration:\n" + item), m); },
+      "unknown key (did you mean configurations?)");
+  std::string other_mesh = item;  // a volume of another mesh
+  other_mesh.replace(other_mesh.find("900_prone.vtk"), 13, "rest_wrong.vtk");
+  PhantomOptions po;
+  po.tet.cell_size = 0.015;
+  write_tet_mesh(dir + "/rest_wrong.vtk", make_phantom_model(po).rest, LengthUnit::Millimetre);
+  test::expect_throw_with<InputError>(
+      [&] { load_given_configurations(truth("units: mm\nconfigurations:\n" + other_mesh), m); },
+      "field 'configurations[0].prone': ");
+  std::string missing_tumour = item.substr(0, item.find("      top:"));
+  test::expect_throw_with<InputError>(
+      [&] { load_given_configurations(truth("units: mm\nconfigurations:\n" + missing_tumour), m); },
+      "tumour 'top' of the rest model is missing");
+  std::string unknown_tumour = item;
+  unknown_tumour.replace(unknown_tumour.find("      top:"), 10, "      tip:");
+  test::expect_throw_with<InputError>(
+      [&] { load_given_configurations(truth("units: mm\nconfigurations:\n" + unknown_tumour), m); },
+      "field 'configurations[0].tumours.tip': the rest model has no tumour of that name");
 }
 
 TEST(RestModelErrors, NameTheFieldAtFault) {
