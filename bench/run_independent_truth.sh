@@ -4,7 +4,7 @@
 # (the thesis), unloaded at the assumed 3400 Pa, and unloaded at an estimated E, each homogeneous
 # and (the last two) with the tissue regions, and prints a markdown table of the worst tumour
 # error, then per fat E the tumours' shape (bench/summarize_tumours.py). Needs python3-sfepy and tetgen (Debian):
-#   apt-get install -y python3-sfepy tetgen
+#   apt-get install -y python3-sfepy python3-petsc4py tetgen   (petsc4py: MUMPS, 20x faster than SuperLU)
 # Usage: bash bench/run_independent_truth.sh OUT [fat E [Pa] ...]   (default 300 1000 3400)
 set -euo pipefail
 OUT=${1:?usage: run_independent_truth.sh OUT [fat E ...]}

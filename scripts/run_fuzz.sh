@@ -12,7 +12,7 @@ SECONDS_EACH="${1:-30}"
 JUNIT="${2:-}"
 BUILD="$REPO_ROOT/build/fuzz"
 export PATH="/usr/bin:$PATH"
-TARGETS=(fuzz_surface fuzz_tet_mesh fuzz_index fuzz_scene fuzz_model fuzz_pointcloud2 fuzz_markups fuzz_label_volume)
+TARGETS=(fuzz_surface fuzz_tet_mesh fuzz_index fuzz_scene fuzz_model fuzz_pointcloud2 fuzz_markups fuzz_label_volume fuzz_truth)
 
 mkdir -p "$BUILD/artifacts"
 if ! { cmake -S "$REPO_ROOT/test/fuzz" -B "$BUILD" -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=None >"$BUILD/configure.log" 2>&1 &&

@@ -39,7 +39,9 @@ std::string plan_fingerprint(const ExperimentSuiteOptions& opt, const std::vecto
   std::ostringstream s;
   s.precision(17);
   s << opt.preset << '|' << opt.poisson_ratio << '|' << opt.density << '|' << opt.rest_shape << '|'
-    << model_vertices << '|' << model_tetrahedra << '|';
+    << model_vertices << '|' << model_tetrahedra << '|' << opt.simulation_cell_size << '|'
+    << to_string(opt.method_volume_form) << '|'
+    << (opt.given_configurations ? "given" : "generated") << '|';
   for (double e : opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli) s << e << ',';
   for (const auto& r : runs) s << '|' << r.experiment << ':' << r.setting << ':' << r.variable << '=' << r.value;
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a

@@ -13,6 +13,7 @@
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/simulation/experiment_shards.h"
 
 namespace btr {
@@ -278,7 +279,9 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
       std::string failure = generation_failure;
       if (failure.empty()) {
         try {
-          const Scene scene = experiment_scene(model, conf, *run, opt.preset, opt.rest_shape);
+          Scene scene = experiment_scene(model, conf, *run, opt.preset, opt.rest_shape);
+          scene.material.volume_form = opt.method_volume_form;
+          if (opt.simulation_cell_size > 0) scene = with_simulation_mesh(scene, opt.simulation_cell_size);
           std::vector<std::string> warnings;
           // The unloaded shape depends on the configuration and the method's material only:
           // estimated once per both, then reused (its time still counts in every run's seconds).

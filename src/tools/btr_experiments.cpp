@@ -43,6 +43,18 @@ int main(int argc, char** argv) {
                  "elsewhere (another FEM code), run instead of generating them; -E picks among its moduli (default: "
                  "all of them)")
       ->needs(app.get_option("--model"));
+  double simulation_cell_mm = 0;
+  app.add_option("--simulation-cell-size", simulation_cell_mm,
+                 "re-tetrahedralize every run's prone model at this size [mm], as btr_register meshes a prone surface "
+                 "(0: simulate on the model's own mesh; with --truth, the mesh the truth was computed on)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  std::string volume_form = "auto";
+  app.add_option("--volume-form", volume_form,
+                 "the method's volume term: auto (element below nu = 0.495), element or nodal (no locking, slower); "
+                 "the generated truth keeps its own")
+      ->check(CLI::IsMember({"auto", "element", "nodal"}))
+      ->capture_default_str();
   app.add_option("--cell-size", cell_mm, "built-in phantom: tetrahedron size bound [mm] (8: ~6k tets, 4.7: ~35k)")
       ->capture_default_str();
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
@@ -82,6 +94,8 @@ int main(int argc, char** argv) {
     opt.quick = quick;
     opt.preset = preset;
     opt.rest_shape = rest_shape;
+    opt.simulation_cell_size = simulation_cell_mm * 1e-3;
+    opt.method_volume_form = parse_volume_form(volume_form);
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};
     preset_options(preset);  // validates the name before the expensive steps
     const std::vector<ExperimentRun> runs = plan_experiments(opt);
