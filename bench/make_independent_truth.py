@@ -50,7 +50,7 @@ for _d in ('/usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real', '/usr/lib/petsc'
         sys.path.append(_p)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_shape_model import icosphere, surface, write_obj  # noqa: E402
+from make_shape_model import icosphere, surface, write_obj, write_vtk  # noqa: E402
 
 G = 9.81
 RHO = 1000.0
@@ -137,21 +137,6 @@ def linear_solver_of(name):
 
         return MumpsDirect({})
     return ScipyDirect({})
-
-
-def write_vtk(path, V, T, labels=None):
-    """Legacy ASCII VTK unstructured grid of linear tetrahedra [mm], with cell labels."""
-    with open(path, 'w') as f:
-        f.write('# vtk DataFile Version 3.0\nbench/make_independent_truth.py\nASCII\nDATASET UNSTRUCTURED_GRID\n')
-        f.write('POINTS %d double\n' % len(V))
-        f.writelines('%.12g %.12g %.12g\n' % tuple(v) for v in V)
-        f.write('CELLS %d %d\n' % (len(T), 5 * len(T)))
-        f.writelines('4 %d %d %d %d\n' % tuple(t) for t in T)
-        f.write('CELL_TYPES %d\n' % len(T))
-        f.writelines('10\n' for _ in T)
-        if labels is not None:
-            f.write('CELL_DATA %d\nSCALARS label int 1\nLOOKUP_TABLE default\n' % len(T))
-            f.writelines('%d\n' % k for k in labels)
 
 
 def write_rest_model(out, node, ele, lab, chest_vertices, landmarks, tum_surf):

@@ -90,6 +90,21 @@ def write_obj(path, V, F):
         f.writelines('f %d %d %d\n' % tuple(t + 1) for t in F)
 
 
+def write_vtk(path, V, T, labels=None):
+    """Legacy ASCII VTK unstructured grid of linear tetrahedra [mm], with cell labels."""
+    with open(path, 'w') as f:
+        f.write('# vtk DataFile Version 3.0\nTetGen tetrahedra [mm] (bench/)\nASCII\nDATASET UNSTRUCTURED_GRID\n')
+        f.write('POINTS %d double\n' % len(V))
+        f.writelines('%.12g %.12g %.12g\n' % tuple(v) for v in V)
+        f.write('CELLS %d %d\n' % (len(T), 5 * len(T)))
+        f.writelines('4 %d %d %d %d\n' % tuple(t) for t in T)
+        f.write('CELL_TYPES %d\n' % len(T))
+        f.writelines('10\n' for _ in T)
+        if labels is not None:
+            f.write('CELL_DATA %d\nSCALARS label int 1\nLOOKUP_TABLE default\n' % len(T))
+            f.writelines('%d\n' % k for k in labels)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument('dir')
@@ -109,14 +124,7 @@ def main():
     subprocess.run(['tetgen', '-pq1.4a%g' % o.max_volume, '-zQ', os.path.join(o.dir, 'surface.off')], check=True)
     node = np.loadtxt(os.path.join(o.dir, 'surface.1.node'), comments='#', skiprows=1)[:, 1:4]
     ele = np.loadtxt(os.path.join(o.dir, 'surface.1.ele'), comments='#', skiprows=1, dtype=int)[:, 1:5]
-    with open(os.path.join(o.dir, 'rest.vtk'), 'w') as f:
-        f.write('# vtk DataFile Version 3.0\nrest model by bench/make_shape_model.py (TetGen)\nASCII\nDATASET UNSTRUCTURED_GRID\n')
-        f.write('POINTS %d double\n' % len(node))
-        f.writelines('%.9g %.9g %.9g\n' % tuple(p) for p in node)
-        f.write('CELLS %d %d\n' % (len(ele), 5 * len(ele)))
-        f.writelines('4 %d %d %d %d\n' % tuple(e) for e in ele)
-        f.write('CELL_TYPES %d\n' % len(ele))
-        f.writelines('10\n' for _ in ele)
+    write_vtk(os.path.join(o.dir, 'rest.vtk'), node, ele)
     wall = np.nonzero(np.abs(node[:, 2]) < 1e-9)[0]
     np.savetxt(os.path.join(o.dir, 'chest_wall.txt'), wall, fmt='%d')
     # Landmarks: input surface vertices (TetGen keeps them first): the apex and four around it.
