@@ -141,7 +141,14 @@ PlannedSteps plan_steps(const Scene& s) {
   }
   if (!p.rigid_landmarks && !p.rigid_icp && !p.gravity && !p.landmarks && !p.surface)
     throw InputError(s.path + ": nothing to do: the scene has no landmarks, no supine surface and no rigid regions");
+  if (!plan_simulates(s)) p.unload = p.stiffness = false;
   return p;
+}
+
+bool plan_simulates(const Scene& s) {
+  const bool auto_steps = s.steps.empty();
+  const bool have_lm = s.landmark_anchors.size() > 0, have_supine = s.supine_surface || s.supine_cloud;
+  return requested(s, "gravity") || (auto_steps ? have_lm || have_supine : requested(s, "landmarks") || requested(s, "surface"));
 }
 
 bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt) {
@@ -175,7 +182,8 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
   }
   // Last: it simulates with the final materials (a stiffer tumour included).
   // Its note (a stop before converging) reaches the result's warnings with the step reports.
-  if (scene.prone_gravity && !scene.youngs_modulus_range) unload_model(m, *scene.prone_gravity, unload, cache);
+  if (scene.prone_gravity && !scene.youngs_modulus_range && plan_simulates(scene))
+    unload_model(m, *scene.prone_gravity, unload, cache);
   return m;
 }
 

@@ -258,6 +258,20 @@ TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
   unload.steps = {"landmarks", "surface"};
   EXPECT_TRUE(plan_steps(unload).unload);
   EXPECT_EQ(plan_steps(unload).describe(), "unload + landmarks + surface");
+  // Rigid alignment alone reads neither the rest shape nor the material: no unload, no stiffness.
+  unload.steps = {"rigid"};
+  EXPECT_EQ(plan_steps(unload).describe(), "rigid (landmarks) + rigid (ICP)");
+  EXPECT_FALSE(plan_simulates(unload));
+  std::vector<std::string> rigid_warnings;
+  const RegistrationModel rigid_model = prepare_model(unload, rigid_warnings);
+  EXPECT_FALSE(rigid_model.unload.has_value());
+  EXPECT_TRUE(run_registration(unload, rigid_model, preset_options("fast")).converged);
+  unload.youngs_modulus_range = std::array<double, 2>{150, 24000};
+  EXPECT_EQ(plan_steps(unload).describe(), "rigid (landmarks) + rigid (ICP)");
+  EXPECT_TRUE(run_registration(unload, rigid_model, preset_options("fast")).converged);
+  unload.steps = {"landmarks", "surface"};
+  EXPECT_EQ(plan_steps(unload).describe(), "stiffness + unload + landmarks + surface");
+  unload.youngs_modulus_range.reset();
   Scene listed = full;
   listed.steps = {"unload", "surface"};
   expect_throw_with<InputError>([&] { plan_steps(listed); }, "'unload' needs the field 'prone_gravity'");

@@ -73,11 +73,15 @@ struct PlannedSteps {
 /// Steps for the scene: `auto` (scene.steps empty) takes every step its inputs allow
 /// (rigid when it has >= 3 landmarks or both rigid regions; landmarks; surface). An
 /// explicit list is checked against the inputs; a missing input is an InputError naming
-/// the field. `unload` is planned exactly when the scene gives prone_gravity, listed or not:
-/// it changes the model every other step simulates, not the data they fit. `stiffness` is
-/// planned exactly when the scene says `youngs_modulus: estimate`, and needs prone_gravity and
-/// >= 3 landmarks.
+/// the field. `unload` is planned exactly when the scene gives prone_gravity and the plan
+/// simulates (plan_simulates), listed or not: it changes the model every other step simulates,
+/// not the data they fit. `stiffness` is planned exactly when the scene says
+/// `youngs_modulus: estimate` and the plan simulates, and needs prone_gravity and >= 3 landmarks.
 PlannedSteps plan_steps(const Scene& scene);
+/// Whether the scene's steps simulate (gravity, landmarks or surface): only they read the rest
+/// shape and the material, so a plan of rigid alignment alone neither estimates the stiffness
+/// nor unloads (before: a rigid-only run of the suite on a 300 Pa body spent 129 s estimating E).
+bool plan_simulates(const Scene& scene);
 
 /// When opt.simulation_cell_size asks for a clearly coarser mesh than the scene's (mean edge
 /// below 1.1 cell sizes; a mesh made at that size has about 1.35): the scene with its prone model re-tetrahedralized
