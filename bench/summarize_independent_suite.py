@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Tables of bench/run_independent_suite.sh: the quick suite on SfePy's independent truth beside
 our phantom, per generating (fat) E. Worst tumour centroid error [mm] of a run; * marks a run that
-did not converge.
+did not converge; "failed": the run could not start (e.g. the truth's own mesh inverted).
 Usage: /usr/bin/python3 bench/summarize_independent_suite.py OUT"""
 import collections, csv, os, statistics, sys
 
@@ -27,6 +27,8 @@ def load(name):
 def cell(runs, exp, value, e):
     for (x, setting, v, ee, var), (w, st, s, est) in runs.items():
         if x == exp and v == value and ee == e:
+            if st.startswith('failed'):
+                return 'failed'
             return '%.2f%s' % (w, '' if st.startswith('converged') else '*')
     return '-'
 
@@ -47,7 +49,7 @@ for body in ('sfepy', 'phantom'):
                 row.append('-'), nc.append('-')
                 continue
             row.append(cell(runs, 'practical', 'full', e))
-            if rigid == '-':
+            if rigid in ('-', 'failed'):
                 rigid = cell(runs, 'practical', 'rigid', e)
             here = [st for k, (w, st, s, est) in runs.items() if k[3] == e]
             nc.append('%d/%d' % (sum(not st.startswith('converged') for st in here), len(here)))
