@@ -88,9 +88,7 @@ Scene load_scene_fields(const std::string& path) {
   c.check_keys(root, kSceneKeys);
   Scene s;
   s.path = path;
-  if (!root["units"]) c.fail("units", "missing: say in which unit the files' lengths are (units: mm or units: m)");
-  const std::string units = c.text(root["units"], "units");
-  s.units = c.load("units", [&] { return parse_length_unit(units); });
+  s.units = c.length_unit(root);
 
   // Prone model.
   const YAML::Node prone = root["prone"];

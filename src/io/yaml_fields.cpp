@@ -68,6 +68,12 @@ void check_map(const YamlFields& c, const YAML::Node& node, const std::string& p
 
 }  // namespace
 
+LengthUnit YamlFields::length_unit(const YAML::Node& root) const {
+  if (!root["units"]) fail("units", "missing: say in which unit the files' lengths are (units: mm or units: m)");
+  const std::string units = text(root["units"], "units");
+  return load("units", [&] { return parse_length_unit(units); });
+}
+
 void YamlFields::check_keys(const YAML::Node& root, const std::vector<std::string>& valid) const {
   check_map(*this, root, "", std::set<std::string>(valid.begin(), valid.end()), valid);
 }

@@ -46,9 +46,7 @@ std::map<double, PhantomConfigurations> load_fields(const std::string& path, con
   const YamlFields c{path, fs::path(path).parent_path()};
   const YAML::Node root = YamlFields::load_mapping(path, "truth file");
   c.check_keys(root, kTruthKeys);
-  if (!root["units"]) c.fail("units", "missing: say in which unit the files' lengths are (units: mm or units: m)");
-  const std::string units = c.text(root["units"], "units");
-  const LengthUnit unit = c.load("units", [&] { return parse_length_unit(units); });
+  const LengthUnit unit = c.length_unit(root);
   const YAML::Node list = root["configurations"];
   if (!list || !list.IsSequence() || list.size() == 0)
     c.fail("configurations", "expected a list of {youngs_modulus, prone, supine, tumours}");

@@ -25,9 +25,7 @@ PhantomModel load_rest_model_fields(const std::string& path) {
   const YamlFields c{path, fs::path(path).parent_path()};
   const YAML::Node root = YamlFields::load_mapping(path, "rest model");
   c.check_keys(root, kModelKeys);
-  if (!root["units"]) c.fail("units", "missing: say in which unit the files' lengths are (units: mm or units: m)");
-  const std::string units = c.text(root["units"], "units");
-  const LengthUnit unit = c.load("units", [&] { return parse_length_unit(units); });
+  const LengthUnit unit = c.length_unit(root);
   for (const char* f : {"chest_wall", "landmarks", "tumours", "gravity"})
     if (!root[f]) c.fail(f, "missing (a rest model needs rest or surface, chest_wall, landmarks, tumours and gravity)");
   if (!root["gravity"].IsMap() || !root["gravity"]["prone"] || !root["gravity"]["supine"])

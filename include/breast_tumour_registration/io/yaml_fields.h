@@ -10,6 +10,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/types.h"
+#include "breast_tumour_registration/base/units.h"
 
 namespace btr {
 
@@ -48,6 +49,8 @@ struct YamlFields {
   /// maps in a list, and "a.*" for a free-form mapping. An unknown key is an error that names
   /// the nearest valid key ("did you mean prone.cell_size_mm?").
   void check_keys(const YAML::Node& root, const std::vector<std::string>& valid) const;
+  /// The file's required `units` field (m or mm): missing or unknown is an error naming it.
+  LengthUnit length_unit(const YAML::Node& root) const;
   /// A scalar read as T; a list or mapping, or a value that is not a T, is an error naming the
   /// field and what was expected.
   template <class T>
