@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <map>
 #include <random>
+#include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/vertex_normals.h"
@@ -141,11 +142,17 @@ RegistrationResult RegistrationEngine::solve(const Scene& supine, const Registra
 RegistrationResult RegistrationEngine::solve_live(const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions opt,
                                                   const StepCallback& callback) {
   Entry& e = entry(opt);
+  const Scene s = live_call(e, scan, live, opt);
+  return run(e, s, opt, callback);
+}
+
+Scene RegistrationEngine::live_call(const Entry& e, const LiveScan& scan, const LiveSceneOptions& live,
+                                    RegistrationOptions& opt) {
   LiveScene ls = live_scene(e.prepared.scene, scan, live);
   ls.scene.preset = opt.preset;
   opt.known_supine_to_model = ls.known_supine_to_model;
   opt.known_pose_covariance = ls.known_pose_covariance;
-  return run(e, ls.scene, opt, callback);
+  return std::move(ls.scene);
 }
 
 SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources,
@@ -160,11 +167,8 @@ SampledUncertainty RegistrationEngine::sample_uncertainty_live(const LiveScan& s
                                                               RegistrationOptions opt, const UncertaintyOptions& sources,
                                                               int samples, unsigned seed, const RegistrationResult& nominal) {
   Entry& e = entry(opt);
-  LiveScene ls = live_scene(e.prepared.scene, scan, live);
-  ls.scene.preset = opt.preset;
-  opt.known_supine_to_model = ls.known_supine_to_model;
-  opt.known_pose_covariance = ls.known_pose_covariance;
-  return sample(e, ls.scene, opt, sources, samples, seed, nominal);
+  const Scene s = live_call(e, scan, live, opt);
+  return sample(e, s, opt, sources, samples, seed, nominal);
 }
 
 SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, const RegistrationOptions& opt,

@@ -86,6 +86,9 @@ class RegistrationEngine {
   };
   Entry& entry(const RegistrationOptions& opt);
   RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);
+  /// The scene of a live scan on `e`'s prepared scene; `opt` takes the tracked pose it decides
+  /// and that pose's covariance (solve_live and sample_uncertainty_live alike).
+  static Scene live_call(const Entry& e, const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions& opt);
   /// Sampling on `scene` (the prepared scene with the call's supine side).
   SampledUncertainty sample(Entry& e, const Scene& scene, const RegistrationOptions& opt, const UncertaintyOptions& sources,
                             int samples, unsigned seed, const RegistrationResult& nominal);
