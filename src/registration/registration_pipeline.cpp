@@ -151,6 +151,8 @@ bool plan_simulates(const Scene& s) {
   return requested(s, "gravity") || (auto_steps ? have_lm || have_supine : requested(s, "landmarks") || requested(s, "surface"));
 }
 
+bool unloads_in_preparation(const Scene& s) { return s.prone_gravity && !s.youngs_modulus_range && plan_simulates(s); }
+
 bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt) {
   if (opt.simulation_cell_size <= 0) return false;
   // CGAL's meshes at cell size c have a mean edge of about 1.35 c (1.34 measured on the
@@ -182,8 +184,7 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
   }
   // Last: it simulates with the final materials (a stiffer tumour included).
   // Its note (a stop before converging) reaches the result's warnings with the step reports.
-  if (scene.prone_gravity && !scene.youngs_modulus_range && plan_simulates(scene))
-    unload_model(m, *scene.prone_gravity, unload, cache);
+  if (unloads_in_preparation(scene)) unload_model(m, *scene.prone_gravity, unload, cache);
   return m;
 }
 
@@ -196,7 +197,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   RegistrationResult r;
   r.warnings = scene.warnings;
   r.steps = plan_steps(scene);
-  const bool unloaded_in_preparation = r.steps.unload && !r.steps.stiffness;
+  const bool unloaded_in_preparation = unloads_in_preparation(scene);
   if (unloaded_in_preparation != prepared.unload.has_value())
     throw InputError(unloaded_in_preparation ? "the scene gives prone_gravity but the model was prepared without the unload step"
                                              : "the model was unloaded but the scene does not ask for it here");

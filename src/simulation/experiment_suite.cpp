@@ -289,7 +289,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           without_unload.prone_gravity.reset();
           RegistrationModel rm = prepare_model(without_unload, warnings);
           double unload_seconds = 0;
-          if (scene.prone_gravity && !scene.youngs_modulus_range && plan_simulates(scene)) {
+          if (unloads_in_preparation(scene)) {
             auto it = unloaded.find(run->method_youngs_modulus);
             if (it == unloaded.end()) {
               const StepReport u = unload_model(rm, *scene.prone_gravity);

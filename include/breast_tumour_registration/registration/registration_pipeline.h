@@ -82,6 +82,9 @@ PlannedSteps plan_steps(const Scene& scene);
 /// shape and the material, so a plan of rigid alignment alone neither estimates the stiffness
 /// nor unloads (before: a rigid-only run of the suite on a 300 Pa body spent 129 s estimating E).
 bool plan_simulates(const Scene& scene);
+/// Whether the model is unloaded when it is prepared (prepare_model): the plan unloads and
+/// does not estimate the stiffness (which unloads per candidate instead).
+bool unloads_in_preparation(const Scene& scene);
 
 /// When opt.simulation_cell_size asks for a clearly coarser mesh than the scene's (mean edge
 /// below 1.1 cell sizes; a mesh made at that size has about 1.35): the scene with its prone model re-tetrahedralized
