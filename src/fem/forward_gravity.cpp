@@ -72,13 +72,14 @@ int ForwardGravity::solve(const Points& X, const Vec3& gravity, Points& x) {
     Points xs = x;
     nr = solve_once(X, next * gravity, xs);
     n += nr.iterations;
+    continuation_steps_.emplace_back(next, nr.converged);
     if (nr.converged) {
       x = xs;
       s = next;
       ++load_steps_;
       ds *= 1.5;
     } else {
-      ds *= 0.5;
+      ds = 0.5 * (next - s);  // half the step that failed (ds may reach past the full load)
       if (ds < opt_.min_load_fraction) {
         x = start;
         throw SolverError("forward gravity solve stopped without converging at " +

@@ -206,7 +206,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
         if (s >= 1) result = st;
       } else {
         failure = "at " + std::to_string(static_cast<int>(std::lround(next * 100))) + " % of the gravity: " + st.reason;
-        ds *= 0.5;
+        ds = 0.5 * (next - s);  // half the stage that failed (ds may reach past the full gravity)
         if (ds < 1.0 / 64) break;
       }
     }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/units.h"
@@ -50,10 +51,22 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   const TetMesh prone{model.prone, model.rest.T};
   StiffnessEstimate est;
   NewtonSolver* shared = cache ? &cache->gravity(model) : nullptr;
+  if (!(opt.candidate_tolerance > 0) || !std::isfinite(opt.candidate_tolerance))
+    throw InputError("stiffness: the candidates' unload tolerance must be positive");
+  UnloadOptions candidate_unload = opt.unload;
+  candidate_unload.tolerance = std::max(opt.unload.tolerance, opt.candidate_tolerance);
 
   // The last two candidates' (log E, unloaded shape): the next one starts from their
   // extrapolation, which saves most of the cost of a soft candidate.
   std::vector<std::pair<double, Points>> known;
+  // The last simulated candidate's log E and supine displacement: the next candidate's supine
+  // solve starts from it scaled by the stiffness ratio (in the linear range displacement goes
+  // as 1/E) rather than from rest (a start that inverts an element falls back to rest).
+  struct Supine {
+    double u = 0;
+    Points displacement;
+  };
+  std::optional<Supine> last_supine;
   struct Candidate {
     double misfit = std::numeric_limits<double>::infinity();
     Points rest;
@@ -76,11 +89,11 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
       guess = known.back().second;
       pb.initial_rest = &guess;
     }
-    c.unload = estimate_unloaded_shape(pb, opt.unload);
+    c.unload = estimate_unloaded_shape(pb, candidate_unload);
     if (!pb.initial_rest || !c.unload.converged) {  // the extrapolation misled it: from inverse gravity
       if (pb.initial_rest && !c.unload.converged) {
         pb.initial_rest = nullptr;
-        UnloadResult fresh = estimate_unloaded_shape(pb, opt.unload);
+        UnloadResult fresh = estimate_unloaded_shape(pb, candidate_unload);
         if (fresh.max_mismatch < c.unload.max_mismatch) c.unload = std::move(fresh);
       }
     }
@@ -92,7 +105,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
       if (known.size() > 2) known.erase(known.begin());
     }
     // A candidate whose unloaded shape does not reproduce the prone shape is not a candidate.
-    if (!(c.unload.max_mismatch < std::max(10 * opt.unload.tolerance, opt.unload.stage_tolerance))) {
+    if (!(c.unload.max_mismatch < std::max({10 * opt.unload.tolerance, opt.unload.stage_tolerance, candidate_unload.tolerance}))) {
       est.evaluations.emplace_back(E, c.misfit);
       return c;
     }
@@ -100,12 +113,17 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     ForwardGravity phi(model.rest.T, model.prone.rows(), model.chest_wall, model.materials, model.material_of,
                        model.volume_form, model.material.density, opt.unload.forward, shared);
     Points x = c.rest;
+    if (last_supine) {
+      x = c.rest + std::exp(last_supine->u - u) * last_supine->displacement;
+      if (count_inverted(x, model.rest.T) > 0) x = c.rest;
+    }
     try {
       phi.solve(c.rest, model.gravity / k, x);
     } catch (const SolverError&) {
       est.evaluations.emplace_back(E, c.misfit);
       return c;
     }
+    last_supine = Supine{u, x - c.rest};
     Points predicted(static_cast<Eigen::Index>(anchors.size()), 3);
     for (size_t i = 0; i < anchors.size(); ++i) predicted.row(static_cast<Eigen::Index>(i)) = anchors[i].position(x).transpose();
     const Rigid T = kabsch(supine, predicted);
@@ -197,9 +215,10 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   }
   est.youngs_modulus = std::exp(u_best);
   est.scale = est.youngs_modulus / E0;
-  // A candidate is accepted once its unloaded shape reproduces the prone shape within 0.1 mm;
-  // the chosen one is finished from there, so that the unload step's "converged" holds.
-  if (!c_best.unload.converged) {
+  // A candidate is accepted once its unloaded shape reproduces the prone shape within
+  // candidate_tolerance; the chosen one is finished from there to unload.tolerance, so that the
+  // unload step's "converged" means the unload's own criterion held.
+  if (!c_best.unload.converged || c_best.unload.max_mismatch > opt.unload.tolerance) {
     UnloadProblem pb = unload_problem(model, prone, prone_gravity / est.scale);
     pb.solver = shared;
     pb.initial_rest = &c_best.rest;
@@ -208,6 +227,13 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
       polished.seconds += c_best.unload.seconds;
       c_best.unload = std::move(polished);
       c_best.rest = c_best.unload.rest;
+    }
+    if (c_best.unload.max_mismatch > opt.unload.tolerance && c_best.unload.converged) {  // met only the candidates' bound
+      c_best.unload.converged = false;
+      char b[160];
+      std::snprintf(b, sizeof b, "re-simulating reproduces the prone shape within %.3g mm, not %.3g mm: finishing the chosen candidate did not get there",
+                    c_best.unload.max_mismatch * 1e3, opt.unload.tolerance * 1e3);
+      c_best.unload.stop_reason = b;
     }
   }
   est.misfit = c_best.misfit;

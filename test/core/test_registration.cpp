@@ -298,6 +298,9 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
               r.estimated_youngs_modulus, r.stiffness_evaluations.size(), r.reports[0].stop_reason.c_str(),
               r.reports[0].seconds, worst_error(r) * 1e3);
   EXPECT_TRUE(r.reports[0].converged) << r.reports[0].stop_reason;
+  // The candidates are unloaded to 0.1 mm; the chosen one is finished to the unload's own 0.01.
+  EXPECT_TRUE(r.reports[1].converged) << r.reports[1].stop_reason;
+  EXPECT_NE(r.reports[1].stop_reason.find("within 0.010 mm"), std::string::npos) << r.reports[1].stop_reason;
   EXPECT_NEAR(r.estimated_youngs_modulus, 600, 60);
   EXPECT_LT(worst_error(r), 0.5e-3);
   EXPECT_TRUE(r.converged);

@@ -104,3 +104,49 @@ TEST(Unload, AtOneHundredPascalItConvergesOrSaysWhyNot) {
   }
   EXPECT_EQ(count_inverted(r.rest, prone.T), 0);
 }
+
+// A continuation step clipped at the full load (s + ds > 1) that fails is halved from the step
+// actually taken: before, ds was halved while s + ds still passed 1, so the very same full
+// load was tried again, each time to the Newton cap (587 Newton iterations for one supine
+// solve of the stiffness search's 150 Pa candidate on the phantom, 281 after). Here Newton
+// gets too few iterations for the soft phantom's last step to the full load: the step after a
+// failed one tries a smaller load, and the equilibrium reached is that of a generous solve.
+TEST(ForwardGravity, AFailedStepIsHalvedFromTheLoadItTried) {
+  PhantomOptions po;
+  po.tet.cell_size = 0.012;
+  po.surface_rings = 12;
+  const PhantomModel model = make_phantom_model(po);
+  const double E = 200, nu = 0.49;
+  const VolumeForm form = resolve_volume_form(VolumeForm::Auto, nu);
+  // 0.6 of the load converges within the cap, the rest in one step does not: the step to the
+  // full load fails (the old rule then tried the full load again).
+  ForwardGravityOptions tight;
+  tight.newton.max_iterations = 7;
+  tight.first_load_fraction = 0.6;
+  tight.newton.gradient_rel_tolerance = 1e-8;
+  ForwardGravity phi(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(E, nu)}, {}, form, 1000, tight);
+  Points x = model.rest.V;
+  phi.solve(model.rest.V, model.prone_gravity, x);
+  const auto& steps = phi.continuation_steps();
+  std::printf("tight Newton cap: %d Newton iterations, continuation steps:", phi.newton_iterations());
+  int failures = 0;
+  for (const auto& [f, ok] : steps) {
+    std::printf(" %.3f%s", f, ok ? "" : " (failed)");
+    failures += !ok;
+  }
+  std::printf("\n");
+  ASSERT_GE(failures, 1) << "the test needs a failing step";
+  for (size_t i = 1; i < steps.size(); ++i) {
+    if (!steps[i - 1].second) {
+      EXPECT_LT(steps[i].first, steps[i - 1].first) << "step " << i << " retried a failed load";
+    }
+  }
+  EXPECT_EQ(steps.back().first, 1.0);
+  EXPECT_TRUE(steps.back().second);
+  ForwardGravityOptions generous = tight;
+  generous.newton.max_iterations = 200;
+  ForwardGravity ref(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(E, nu)}, {}, form, 1000, generous);
+  Points xr = model.rest.V;
+  ref.solve(model.rest.V, model.prone_gravity, xr);
+  EXPECT_LT((x - xr).rowwise().norm().maxCoeff(), 1e-5);
+}

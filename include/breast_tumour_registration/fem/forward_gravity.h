@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "breast_tumour_registration/fem/elastic_energy.h"
@@ -16,8 +17,9 @@ namespace btr {
 
 struct ForwardGravityOptions {
   NewtonOptions newton;  ///< of each solve (force_scale 0: the body's weight)
-  /// The first load fraction of a continuation, grown 1.5x after a converged fraction and
-  /// halved after a failed one; below min_load_fraction the solve has failed.
+  /// The first load fraction of a continuation; the step is grown 1.5x after a converged
+  /// fraction and the failed step halved after a failed one (so a step clipped at the full
+  /// load is not retried as it was); below min_load_fraction the solve has failed.
   double first_load_fraction = 0.25;
   double min_load_fraction = 1.0 / 64;
 };
@@ -41,6 +43,8 @@ class ForwardGravity {
   bool is_fixed(Eigen::Index v) const { return fixed_[static_cast<size_t>(v)]; }
   int newton_iterations() const { return newton_iterations_; }  ///< over all solves
   int load_steps() const { return load_steps_; }                ///< continuation fractions solved, over all solves
+  /// Every continuation step tried, in order, over all solves: (load fraction, converged).
+  const std::vector<std::pair<double, bool>>& continuation_steps() const { return continuation_steps_; }
 
  private:
   NewtonResult solve_once(const Points& X, const Vec3& gravity, Points& x);
@@ -55,6 +59,7 @@ class ForwardGravity {
   std::unique_ptr<NewtonSolver> own_;
   NewtonSolver* solver_ = nullptr;  ///< own_, or the shared one
   int newton_iterations_ = 0, load_steps_ = 0;
+  std::vector<std::pair<double, bool>> continuation_steps_;
 };
 
 }  // namespace btr

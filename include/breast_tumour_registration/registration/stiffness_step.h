@@ -33,13 +33,17 @@ struct StiffnessOptions {
   int grid_points = 8;                ///< log-spaced over the range
   double relative_tolerance = 0.05;   ///< refinement stops when a step changes E by less than this
   int max_refinements = 6;
-  UnloadOptions unload;               ///< of every candidate's unload
+  /// [m] A candidate's unload stops once re-simulating reproduces the prone shape within this
+  /// (or unload.tolerance, if larger); only the chosen candidate is then finished to
+  /// unload.tolerance. The misfit moves by about this much, far less than between candidates.
+  double candidate_tolerance = 1e-4;
+  UnloadOptions unload;               ///< of every candidate's unload, and of the chosen one's finish
 };
 
 struct StiffnessEstimate {
   double scale = 1;           ///< E / the model's E (every material)
   double youngs_modulus = 0;  ///< [Pa] the estimate for the model's first material
-  double misfit = 0;          ///< [m] RMS landmark misfit of the gravity-only prediction at the estimate
+  double misfit = 0;          ///< [m] RMS landmark misfit of the gravity-only prediction at the estimate (its candidate's unload, within candidate_tolerance of the finished one)
   bool converged = false;     ///< the refinement met relative_tolerance inside the range
   bool at_bound = false;      ///< the best candidate is an end of the range (the estimate is a bound)
   std::string stop_reason;
