@@ -254,6 +254,12 @@ NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, con
     info.gradient_norm = g.norm();
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
+    if (guard.armed && opt.abandon_inverted_fraction > 0 &&
+        static_cast<double>(n_inv - guard.inverted) > opt.abandon_inverted_fraction * static_cast<double>(tets.rows())) {
+      guard.restore_if_worse(x, E, n_inv, res, tets.rows(), 0);  // folding: end here, on the guard's state
+      g = linear.reduce(H.gather(energy.gradient(x)));
+      break;
+    }
     if (local.forbid_new_inversions && info.inversion_limited && info.alpha <= opt.inversion_stall_alpha) {
       // The inversion rule, not the energy, cut the step short: let the line search invert
       // from here (the guard keeps this state if the solve then folds the mesh).

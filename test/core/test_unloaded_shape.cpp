@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
@@ -149,4 +150,55 @@ TEST(ForwardGravity, AFailedStepIsHalvedFromTheLoadItTried) {
   Points xr = model.rest.V;
   ref.solve(model.rest.V, model.prone_gravity, xr);
   EXPECT_LT((x - xr).rowwise().norm().maxCoeff(), 1e-5);
+}
+
+// A gravity solve that can only go on by folding the mesh ends as soon as more than the
+// allowance a solve may end with (0.2 % of the tetrahedra) is newly inverted, not at the
+// iteration cap: the coarse phantom at 100 Pa loaded from rest, a load it cannot carry. The
+// verdict is the same (the continuation stops at the same fraction, the last uninverted state
+// kept), reached in a fraction of the Newton iterations.
+TEST(ForwardGravity, ASolveThatFoldsTheMeshEndsWhenTheFoldPassesTheAllowance) {
+  PhantomOptions po;
+  po.tet.cell_size = 0.012;
+  po.surface_rings = 12;
+  const PhantomModel model = make_phantom_model(po);
+  const double nu = 0.49;
+  const long allowance = static_cast<long>(0.002 * static_cast<double>(model.rest.T.rows()));
+  struct Run {
+    std::string error;
+    int newton = 0, solves = 0, failed = 0, over = 0, over_before_last = 0;
+  };
+  auto run = [&](double abandon) {
+    Run r;
+    ForwardGravityOptions o;
+    o.min_load_fraction = 1.0 / 8;
+    o.newton.abandon_inverted_fraction = abandon;
+    bool last_over = false;
+    o.newton.callback = [&](const IterationInfo& it) {
+      if (it.iteration == 1) ++r.solves;
+      else if (last_over) ++r.over_before_last;  // an iteration after one past the allowance, same solve
+      last_over = it.inverted > allowance;
+      r.over += last_over;
+      return true;
+    };
+    ForwardGravity phi(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(100, nu)}, {},
+                       resolve_volume_form(VolumeForm::Auto, nu), 1000, o);
+    Points x = model.rest.V;
+    try {
+      phi.solve(model.rest.V, model.prone_gravity, x);
+    } catch (const SolverError& e) {
+      r.error = e.what();
+    }
+    r.newton = phi.newton_iterations();
+    for (const auto& s : phi.continuation_steps()) r.failed += !s.second;
+    return r;
+  };
+  const Run before = run(0), after = run(ForwardGravityOptions().newton.abandon_inverted_fraction);
+  std::printf("100 Pa from rest: folding to the cap %d Newton iterations (%d past the allowance), ended at the allowance %d "
+              "(%d); %s\n", before.newton, before.over, after.newton, after.over, after.error.c_str());
+  ASSERT_FALSE(after.error.empty()) << "the test needs a load the phantom cannot carry";
+  EXPECT_EQ(after.error, before.error);
+  EXPECT_EQ(after.over_before_last, 0);  // no iteration after the one that passed the allowance
+  EXPECT_GT(before.over_before_last, 0);  // without the rule the fold goes on
+  EXPECT_LT(3 * after.newton, before.newton);
 }

@@ -72,6 +72,12 @@ struct NewtonOptions {
   /// state, reported); more means the mesh folded to meet its constraints, and the last
   /// uninverted state is kept (StopReason::InvertedAfterStall).
   double max_inverted_fraction_after_stall = 0.002;
+  /// With inversions let in by a stall: once more than this fraction of the tetrahedra is
+  /// newly inverted, the solve ends there as InvertedAfterStall (the guard's state restored)
+  /// instead of folding on to the iteration cap. 0: never; the solve runs on and the count is
+  /// judged at its end. ForwardGravity sets it (a folded gravity equilibrium is no equilibrium
+  /// to keep, and its load continuation needs the failure early).
+  double abandon_inverted_fraction = 0;
   /// A step that the inversion rule cut to this fraction of the Newton step or less is a stall
   /// of its own kind: the line search may invert from then on (as recover_from_stall does; the
   /// inversion guard above still applies). 0: only steps below step_tolerance are stalls. The
