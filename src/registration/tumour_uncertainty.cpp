@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/blas_threads.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/spring_energy.h"
@@ -123,6 +124,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   for (const auto& t : elastic.terms()) jac.add(t);
   jac.add(springs);
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
+  use_single_threaded_blas();
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   llt.cholmod().print = 0;
   jac.hessian(x, false, H);

@@ -1,6 +1,10 @@
+#include <dlfcn.h>
+
+#include <cstdlib>
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/blas_threads.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/line_search.h"
@@ -172,4 +176,22 @@ TEST(LineSearch, SaysWhenTheInversionRuleCutTheStep) {
   EXPECT_FALSE(free.inversion_limited);
   EXPECT_DOUBLE_EQ(free.alpha, 1.0);
   EXPECT_EQ(free.inverted, 1);
+}
+
+// CHOLMOD's dense blocks run on one OpenBLAS thread once a Newton solver exists: its threads
+// only waited on each other on these problems (BENCHMARKS.md, "The stiffness search at the
+// soft end"). An OPENBLAS_NUM_THREADS in the environment rules instead; another BLAS is left be.
+TEST(NewtonSolver, RunsOpenBlasOnOneThreadUnlessTheEnvironmentSays) {
+  const TetMesh m = make_box_tet_mesh(1, 1, 1, Vec3(0.1, 0.1, 0.1));
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, std::vector<bool>{}), m.T);
+  using GetThreads = int (*)();
+  auto get = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  if (!get) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+  if (std::getenv("OPENBLAS_NUM_THREADS")) {
+    EXPECT_FALSE(use_single_threaded_blas());
+    EXPECT_EQ(get(), std::atoi(std::getenv("OPENBLAS_NUM_THREADS")));
+  } else {
+    EXPECT_TRUE(use_single_threaded_blas());
+    EXPECT_EQ(get(), 1);
+  }
 }
