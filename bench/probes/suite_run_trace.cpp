@@ -7,6 +7,12 @@
 //     -o /tmp/trace -L$L -lbtr_simulation -lbtr_registration -lbtr_io -lbtr_geometry -lbtr_fem -lbtr_base -Wl,-rpath,$PWD/$L
 //   PROBE_V=1 /tmp/trace phantom 400 practical surface surface      # MODEL|phantom E experiment setting value
 // PROBE_STALL=N sets stall_projections, PROBE_ISA=a the surface step's inversion_stall_alpha.
+// PROBE_REST=estimated gives the run that rest shape (default prone: the thesis's), and with
+// it the stiffness search's candidates and the estimate are printed; PROBE_CT=t sets the
+// candidates' unload tolerance (1e-5: as before a4689ef). The stiffness search at the soft end
+// (BENCHMARKS.md) was measured with
+//   PROBE_REST=estimated /tmp/trace phantom 300 practical full full
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -27,18 +33,24 @@ int main(int argc, char** argv) {
   ExperimentSuiteOptions o; o.quick = true;
   for (const auto& run : plan_experiments(o)) {
     if (run.experiment != argv[3] || run.setting != argv[4] || run.value != argv[5]) continue;
-    RegistrationEngine engine(experiment_scene(model, conf, run, "balanced", "prone"));
+    const char* rest = std::getenv("PROBE_REST");
+    const auto t0 = std::chrono::steady_clock::now();
+    RegistrationEngine engine(experiment_scene(model, conf, run, "balanced", rest ? rest : "prone"));
     RegistrationOptions ro = preset_options("balanced");
     ro.landmark.weight = run.landmark_weight;
     if (argc > 6) ro.surface.newton.max_iterations = std::atoi(argv[6]);
     if (std::getenv("PROBE_STALL")) ro.surface.stall_projections = std::atoi(std::getenv("PROBE_STALL"));
     if (std::getenv("PROBE_ISA")) ro.surface.inversion_stall_alpha = std::atof(std::getenv("PROBE_ISA"));
+    if (std::getenv("PROBE_CT")) ro.stiffness.candidate_tolerance = std::atof(std::getenv("PROBE_CT"));
     auto cb = [](const std::string& step, const IterationInfo& it) {
       if (std::getenv("PROBE_V")) std::printf("  %s it %d E %.6g |g| %.3g alpha %.3g inv %ld\n", step.c_str(), it.iteration, it.energy, it.gradient_norm, it.alpha, it.inverted);
       return true; };
     const RegistrationResult r = engine.solve(ro, cb);
-    for (const auto& rep : r.reports) std::printf("%s: %s inv %ld: %s\n", rep.name.c_str(), rep.converged ? "C" : "NC", rep.inverted, rep.stop_reason.c_str());
+    for (auto& [e, m] : r.stiffness_evaluations) std::printf("  candidate E %.1f Pa: misfit %.4f mm\n", e, m * 1e3);
+    for (const auto& rep : r.reports)
+      std::printf("%s: %s inv %ld %.2f s: %s\n", rep.name.c_str(), rep.converged ? "C" : "NC", rep.inverted, rep.seconds, rep.stop_reason.c_str());
     double w = 0; for (auto& t : r.tumours) w = std::max(w, t.centroid_distance);
-    std::printf("worst %.3f mm\n", w * 1e3);
+    if (r.estimated_youngs_modulus > 0) std::printf("estimated E %.2f Pa\n", r.estimated_youngs_modulus);
+    std::printf("worst %.4f mm, %.2f s\n", w * 1e3, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
 }

@@ -5,7 +5,7 @@
 // ISA and AB override the forward solves' inversion_stall_alpha and abandon_inverted_fraction
 // (AB=0 ISA=0: as before ecc7e1c). It found the folding solves of SfePy's 300 Pa body
 // with the nodal volume term (BENCHMARKS.md, "The stiffness search at the soft end"). Build as
-// bench/probes/stiffness_search_run.cpp, then:
+// bench/probes/suite_run_trace.cpp, then:
 //   VERB=1 /tmp/cand OUT/truth/model.yaml OUT/truth/truth.yaml 300 nodal 640   # model truth E form candidate-E...
 #include <chrono>
 #include <cstdio>

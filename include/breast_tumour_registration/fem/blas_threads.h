@@ -2,9 +2,9 @@
 // (pthreads) starts one thread per core, and on these problems (a few thousand to tens of
 // thousands of tetrahedra, small supernodes) its threads spend their time waiting on each
 // other (sched_yield in exec_blas_async_wait), taking the cores from the solver's own OpenMP
-// loops. One BLAS thread against two, medians on quiet cores: 1.41 times as fast on a stiffness
-// search on the 300 Pa phantom, 1.07 on a balanced and 1.20 on an accurate registration of the
-// phantom (BENCHMARKS.md, "The stiffness search at the soft end").
+// loops. One BLAS thread against two, medians: 1.41 and 1.54 times as fast (two runs) on a
+// stiffness search on the 300 Pa phantom, 1.07 on a balanced and 1.20 on an accurate
+// registration of the phantom (BENCHMARKS.md, "The stiffness search at the soft end").
 #pragma once
 
 namespace btr {
