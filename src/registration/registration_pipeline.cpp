@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/units.h"
@@ -271,8 +272,22 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
         notes.push_back("the rigid pose is held at its solution: it came from the landmarks, not from ICP on rigid "
                         "regions, whose fit would say how well it is known");
       }
+      // An estimated E is known as well as the landmarks fix it, about the estimate.
+      UncertaintyOptions uopt = opt.uncertainty;
+      if (r.estimated_youngs_modulus > 0 && uopt.sources.samples_youngs_modulus()) {
+        char b[200];
+        if (r.estimated_youngs_modulus_log_sd > 0) {
+          uopt.youngs_modulus_log_sd = r.estimated_youngs_modulus_log_sd;
+          std::snprintf(b, sizeof b, "E as estimated from the landmarks: sd of ln E %.3g about %.0f Pa, not the range's", r.estimated_youngs_modulus_log_sd,
+                        r.estimated_youngs_modulus);
+        } else {
+          std::snprintf(b, sizeof b, "E estimated at %.0f Pa, but how well the landmarks fix it is not known (an end of the range): the range's sd of ln E taken",
+                        r.estimated_youngs_modulus);
+        }
+        notes.push_back(b);
+      }
       const UncertaintyResult u = linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed,
-                                                                opt.uncertainty, pose_covariance);
+                                                                uopt, pose_covariance);
       for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
       r.uncertainty_seconds = u.seconds;
       if (!u.note.empty()) notes.push_back(u.note);

@@ -37,6 +37,7 @@ class StiffnessStep : public RegistrationStep {
     c.result.reports.push_back(rep);
     c.result.estimated_youngs_modulus = est.youngs_modulus;
     c.result.stiffness_evaluations = est.evaluations;
+    c.result.estimated_youngs_modulus_log_sd = est.log_sd(c.opt.uncertainty.sources.landmark_sd);
   }
 };
 

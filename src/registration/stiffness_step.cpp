@@ -23,7 +23,38 @@ std::string pascal(double e) {
   return b;
 }
 double sq(double v) { return v * v; }
+
+// |dr/du| at u0 from the residuals evaluated nearest it on each side (the three-point
+// derivative on uneven spacing; one-sided where the estimate has candidates on one side only).
+// 0 where no other candidate was simulated.
+double residual_slope(const std::vector<std::pair<double, Eigen::VectorXd>>& residuals, double u0) {
+  const Eigen::VectorXd* r0 = nullptr;
+  const std::pair<double, Eigen::VectorXd>*left = nullptr, *right = nullptr;
+  for (const auto& e : residuals) {
+    const double d = e.first - u0;
+    if (std::abs(d) < 1e-12) r0 = &e.second;
+    else if (d < 0 && (!left || e.first > left->first)) left = &e;
+    else if (d > 0 && (!right || e.first < right->first)) right = &e;
+  }
+  if (!r0) return 0;
+  if (left && right) {
+    const double hl = u0 - left->first, hr = right->first - u0;
+    return ((hl * hl * (right->second - *r0) + hr * hr * (*r0 - left->second)) / (hl * hr * (hl + hr))).norm();
+  }
+  const auto* one = left ? left : right;
+  return one ? ((one->second - *r0) / (one->first - u0)).norm() : 0;
+}
 }  // namespace
+
+double StiffnessEstimate::log_sd(double landmark_sd) const {
+  if (!(landmark_sensitivity > 0) || at_bound || landmarks < 3) return 0;
+  // Gauss-Newton: var(ln E) = sigma^2 / |dr/d ln E|^2. sigma: the landmarks' own sd, or the
+  // misfit per residual degree of freedom (3n coordinates less the rigid fit's 6 and E) where
+  // that is larger: the model does not fit the landmarks as well as their noise would let it.
+  const double dof = 3.0 * landmarks - 7.0;
+  const double sigma2 = std::max(landmark_sd * landmark_sd, landmarks * misfit * misfit / dof);
+  return std::sqrt(sigma2) / landmark_sensitivity;
+}
 
 void scale_stiffness(RegistrationModel& model, double scale) {
   if (!(scale > 0) || !std::isfinite(scale)) throw InputError("stiffness: the scale must be positive");
@@ -72,6 +103,9 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     Points rest;
     UnloadResult unload;
   };
+  // Every simulated candidate's log E and Kabsch-fitted landmark residual (3n): the residual's
+  // slope at the estimate says how well the landmarks fix E (StiffnessEstimate::log_sd).
+  std::vector<std::pair<double, Eigen::VectorXd>> residuals;
   auto evaluate = [&](double E) {
     Candidate c;
     const double k = E / E0;  // the material scaled by k == the gravities divided by k
@@ -129,6 +163,8 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     const Rigid T = kabsch(supine, predicted);
     const Points fitted = transform_points(T, supine);
     c.misfit = std::sqrt((fitted - predicted).rowwise().squaredNorm().mean());
+    const Points r = fitted - predicted;
+    residuals.emplace_back(u, Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()));
     est.evaluations.emplace_back(E, c.misfit);
     return c;
   };
@@ -237,6 +273,8 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     }
   }
   est.misfit = c_best.misfit;
+  est.landmarks = static_cast<int>(anchors.size());
+  est.landmark_sensitivity = residual_slope(residuals, u_best);
   est.rest = c_best.rest;
   est.unload = c_best.unload;
   est.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -47,7 +47,11 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
 
 }  // namespace
 
-void validate_uncertainty_options(const UncertaintyOptions& o) { validate_uncertainty_sources(o.sources); }
+void validate_uncertainty_options(const UncertaintyOptions& o) {
+  validate_uncertainty_sources(o.sources);
+  if (!(o.youngs_modulus_log_sd >= 0) || !std::isfinite(o.youngs_modulus_log_sd))
+    throw InputError("uncertainty: the sd of ln E must be >= 0 and finite, got " + std::to_string(o.youngs_modulus_log_sd));
+}
 
 std::array<Vec3, 2> gravity_tilt_axes(const Vec3& gravity) {
   const Vec3 down = gravity.normalized();
@@ -186,7 +190,9 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     const Eigen::MatrixXd lambda = llt.solve(R);  // free DOFs x 3
     TumourUncertainty u;
     u.d_log_youngs_modulus = R_s * Vec3(-lambda.transpose() * b_E);
-    const double sd_log_e = opt.sources.youngs_modulus_log_sd();
+    const double sd_log_e = !opt.sources.samples_youngs_modulus() ? 0.0
+                            : opt.youngs_modulus_log_sd > 0    ? opt.youngs_modulus_log_sd
+                                                               : opt.sources.youngs_modulus_log_sd();
     Mat3 cov_E = sd_log_e * sd_log_e * u.d_log_youngs_modulus *
                  u.d_log_youngs_modulus.transpose();
     Mat3 cov_g = Mat3::Zero();

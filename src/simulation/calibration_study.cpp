@@ -44,7 +44,8 @@ Scene noisy_copy(const Scene& s, const UncertaintySources& src, std::mt19937& rn
 
 void validate_calibration_options(const CalibrationOptions& o) {
   if (o.draws < 1) throw InputError("calibration: draws must be >= 1, got " + std::to_string(o.draws));
-  if (o.samples < 2) throw InputError("calibration: samples must be >= 2, got " + std::to_string(o.samples));
+  if (o.samples < 2 && !(o.samples == 0 && o.linear))
+    throw InputError("calibration: samples must be >= 2 (or 0 with the linearised region alone), got " + std::to_string(o.samples));
 }
 
 void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions& opt,
@@ -80,7 +81,8 @@ void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions&
       SampledUncertainty su;
       try {
         nominal = engine.solve(ro);
-        su = engine.sample_uncertainty(ro, ro.uncertainty, opt.samples, opt.seed * 7919u + static_cast<unsigned>(k), nominal);
+        if (opt.samples > 0)
+          su = engine.sample_uncertainty(ro, ro.uncertainty, opt.samples, opt.seed * 7919u + static_cast<unsigned>(k), nominal);
       } catch (const std::exception& e) {
         say(scenes[si].path + " draw " + std::to_string(k) + ": failed: " + e.what());
         continue;
@@ -95,11 +97,14 @@ void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions&
         row.draw = k;
         row.tilt_deg = Eigen::AngleAxisd(tilt.linear()).angle() * 180 / M_PI;
         row.error = t.centroid_distance;
-        const auto& st = su.tumours[i];
-        int nearer = 0;
-        for (const Vec3& c : st.centroids) nearer += (c - t.centroid).norm() < row.error;
-        row.sampled_radius_95 = st.radius_95;
-        row.sampled_rank = st.centroids.empty() ? nan : static_cast<double>(nearer) / static_cast<double>(st.centroids.size());
+        row.sampled_radius_95 = row.sampled_rank = nan;
+        if (i < su.tumours.size()) {
+          const auto& st = su.tumours[i];
+          int nearer = 0;
+          for (const Vec3& c : st.centroids) nearer += (c - t.centroid).norm() < row.error;
+          row.sampled_radius_95 = st.radius_95;
+          if (!st.centroids.empty()) row.sampled_rank = static_cast<double>(nearer) / static_cast<double>(st.centroids.size());
+        }
         row.linear_radius_95 = t.uncertainty ? t.uncertainty->radius_95 : nan;
         row.linear_level = t.uncertainty ? probability_within(t.uncertainty->covariance, row.error) : nan;
         row.samples = su.samples;

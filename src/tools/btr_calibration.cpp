@@ -10,9 +10,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -23,8 +25,10 @@ using namespace btr;
 
 namespace {
 
+// NaN (a region not computed) left out; NaN when nothing is left.
 double median(std::vector<double> v) {
-  if (v.empty()) return 0;
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
@@ -47,7 +51,7 @@ int main(int argc, char** argv) {
   app.add_option("-o,--out", out_dir, "output folder (created): calibration.csv")->capture_default_str();
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
   app.add_option("--draws", draws, "noisy copies of every scene")->check(CLI::Range(1, 100000))->capture_default_str();
-  app.add_option("--samples", samples, "sampled re-registrations per copy")->check(CLI::Range(2, 100000))->capture_default_str();
+  app.add_option("--samples", samples, "sampled re-registrations per copy (0: the linearised region alone)")->check(CLI::Range(0, 100000))->capture_default_str();
   app.add_option("--seed", seed, "random seed (the copies' noise and the samples)")->capture_default_str();
   app.add_flag("--no-linear", no_linear, "skip the linearised region");
   app.add_flag("-q,--quiet", quiet, "no progress lines");

@@ -289,7 +289,11 @@ TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
 TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   const std::string d = soft_phantom_dir("phantom12_soft_e");
   const std::string estimate = "material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]";
-  const RegistrationResult r = register_scene(scene_with(estimate, "estimate", d));
+  const Scene es = load_meshed_scene(scene_with(estimate, "estimate", d));
+  std::vector<std::string> prep_warnings;
+  RegistrationOptions with_region = preset_options("balanced");
+  with_region.uncertainty.enabled = true;  // the linearised region, to see it take the estimate's spread
+  const RegistrationResult r = run_registration(es, prepare_model(es, prep_warnings), with_region);
   ASSERT_GE(r.reports.size(), 2u);
   EXPECT_EQ(r.reports[0].name, "stiffness");
   EXPECT_EQ(r.reports[1].name, "unload");
@@ -304,6 +308,19 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   EXPECT_NEAR(r.estimated_youngs_modulus, 600, 60);
   EXPECT_LT(worst_error(r), 0.5e-3);
   EXPECT_TRUE(r.converged);
+  // Issue 14: the estimate's own spread (1.5 mm landmarks) replaces the range's in the region:
+  // far narrower than the range's sd of ln E (0.78 for 200 to 3000 Pa), and it holds the truth.
+  const double sd = r.estimated_youngs_modulus_log_sd;
+  std::printf("  sd of ln E from the landmarks %.3f (ln(E / 600 Pa) %+.3f)\n", sd, std::log(r.estimated_youngs_modulus / 600));
+  EXPECT_GT(sd, 0.0);
+  EXPECT_LT(sd, 0.3);
+  EXPECT_LT(std::abs(std::log(r.estimated_youngs_modulus / 600)), 3 * sd);
+  EXPECT_NE(r.uncertainty_note.find("E as estimated from the landmarks"), std::string::npos) << r.uncertainty_note;
+  for (const TumourResult& t : r.tumours) {
+    ASSERT_TRUE(t.uncertainty.has_value());
+    const Vec3& dE = t.uncertainty->d_log_youngs_modulus;
+    EXPECT_NEAR(t.uncertainty->sources[0].second.trace(), sd * sd * dE.squaredNorm(), 1e-12 + 1e-9 * dE.squaredNorm()) << t.name;
+  }
 
   // A range above the truth: the stiff end's bound, said so, and not converged.
   const RegistrationResult b =
@@ -326,6 +343,24 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   expect_throw_with<InputError>(
       [&] { load_meshed_scene(scene_with("material: {youngs_modulus: 600, youngs_modulus_range: [100, 1000]}", "range_only", d)); },
       "only with 'youngs_modulus: estimate'");
+}
+
+// Issue 14: how well the landmarks fix E. Gauss-Newton: sd(ln E) = sigma / |dr/d ln E|, sigma
+// the landmarks' sd, or the misfit per residual degree of freedom (3n - 7) where larger.
+TEST(Stiffness, TheEstimatesSpreadIsTheLandmarkNoiseOverTheMisfitsSlope) {
+  StiffnessEstimate e;
+  e.landmarks = 5;                 // 8 residual degrees of freedom
+  e.landmark_sensitivity = 0.02;   // 20 mm of landmark residual per unit ln E
+  e.misfit = 0.0005;               // 0.5 mm RMS: 5 * 0.25 / 8 mm^2 per coordinate, under 1.5^2
+  EXPECT_NEAR(e.log_sd(0.0015), 0.0015 / 0.02, 1e-12);
+  e.misfit = 0.004;                // 4 mm RMS: the model misses the landmarks by more than their noise
+  EXPECT_NEAR(e.log_sd(0.0015), std::sqrt(5 * 0.004 * 0.004 / 8) / 0.02, 1e-12);
+  EXPECT_NEAR(e.log_sd(0), std::sqrt(5 * 0.004 * 0.004 / 8) / 0.02, 1e-12);
+  e.at_bound = true;               // a bound is not an estimate with a spread
+  EXPECT_EQ(e.log_sd(0.0015), 0);
+  e.at_bound = false;
+  e.landmark_sensitivity = 0;      // no neighbour simulated
+  EXPECT_EQ(e.log_sd(0.0015), 0);
 }
 
 // Issue 10: with face normals the point-to-plane springs jump wherever a skin vertex's closest

@@ -135,6 +135,9 @@ struct RegistrationResult {
   /// material scaled to it
   double estimated_youngs_modulus = 0;
   std::vector<std::pair<double, double>> stiffness_evaluations;  ///< (E [Pa], landmark misfit [m]) it tried
+  /// The sd of ln E about the estimate, from the landmarks' sd (the uncertainty sources') and
+  /// how the misfit moves with E (StiffnessEstimate::log_sd); 0: not known or not estimated
+  double estimated_youngs_modulus_log_sd = 0;
   std::vector<StepReport> reports;
   Points x;                 ///< deformed vertex positions, model frame
   double seconds = 0;       ///< all steps, rigid alignment included

@@ -48,6 +48,15 @@ struct StiffnessEstimate {
   bool at_bound = false;      ///< the best candidate is an end of the range (the estimate is a bound)
   std::string stop_reason;
   std::vector<std::pair<double, double>> evaluations;  ///< (E [Pa], misfit [m]), in the order evaluated (inf: failed)
+  int landmarks = 0;
+  /// [m] |dr / d ln E| at the estimate, r the Kabsch-fitted landmark residual (3n): from the
+  /// simulated candidates nearest the estimate on each side (0: none was).
+  double landmark_sensitivity = 0;
+  /// The sd of ln E about the estimate that landmark noise of `landmark_sd` [m] per axis gives
+  /// (Gauss-Newton, linear about the estimate), widened where the misfit left per residual
+  /// degree of freedom is larger than that noise (model error). 0 when not known: at a bound of
+  /// the range, or no neighbour was simulated.
+  double log_sd(double landmark_sd) const;
   Points rest;                ///< the unloaded shape at the estimate
   UnloadResult unload;        ///< its unload
   double seconds = 0;

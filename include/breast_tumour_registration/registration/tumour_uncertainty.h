@@ -56,6 +56,10 @@ struct UncertaintyOptions {
   /// springs holding the skin tangentially too): an equilibrium of one fixed energy, which
   /// re-solves can reach to round-off, so that the machinery is checked exactly (tests).
   bool held_projections = false;
+  /// > 0: the sd of ln E about the nominal modulus, in place of the range's. The pipeline sets
+  /// it where the stiffness step estimated E from the landmarks (StiffnessEstimate::log_sd): the
+  /// modulus is then known as well as the landmarks fix it, not only as well as the range says.
+  double youngs_modulus_log_sd = 0;
 };
 /// Throws InputError naming the field for a negative or non-finite value.
 void validate_uncertainty_options(const UncertaintyOptions& o);

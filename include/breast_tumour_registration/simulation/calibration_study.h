@@ -23,11 +23,11 @@ namespace btr {
 struct CalibrationOptions {
   RegistrationOptions registration;  ///< the preset (the sources are each scene's `uncertainty`)
   int draws = 4;                     ///< noisy copies of every scene
-  int samples = 32;                  ///< sampled re-registrations per copy
+  int samples = 32;                  ///< sampled re-registrations per copy (0: the linearised region alone)
   unsigned seed = 1;
   bool linear = true;                ///< also the linearised region
 };
-/// InputError naming the option: draws >= 1, samples >= 2.
+/// InputError naming the option: draws >= 1, samples >= 2 (or 0 with `linear`).
 void validate_calibration_options(const CalibrationOptions& o);
 
 struct CalibrationRow {
