@@ -7,7 +7,12 @@
 #  2. The committed truth from an independent FEM code (SfePy, P2, heterogeneous fat / gland /
 #     tumour, fat E 1000 and 3400 Pa), with the prone shape as rest and unloaded with regions.
 # Every scene is registered in BTR_CAL_DRAWS noisy copies (landmarks 1.5 mm, depth 1 mm, gravity
-# 2 deg: the sources' own draws), each with BTR_CAL_SAMPLES sampled re-registrations.
+# 2 deg: the sources' own draws), each with BTR_CAL_SAMPLES sampled re-registrations (0: the
+# linearised region alone).
+# BTR_CAL_STIFFNESS=estimate: the method estimates E from the (noisy) landmarks instead
+# (`youngs_modulus: estimate` with the prone gravity, so the model is unloaded at the estimate):
+# each phantom gets a scene_estimated.yaml beside its scene.yaml, and the independent truth runs
+# its committed scene_estimated_regions.yaml. Every sample then estimates E again.
 # Usage: bash bench/run_calibration.sh OUT [phantom|independent|all]   (BTR_CAL_* below: sizes)
 # Then:  /usr/bin/python3 scripts/plot_calibration.py OUT/*/calibration.csv --out OUT
 set -euo pipefail
@@ -15,6 +20,8 @@ OUT=${1:?usage: run_calibration.sh OUT [phantom|independent|all]}
 WHAT=${2:-all}
 BODIES=${BTR_CAL_BODIES:-8} DRAWS=${BTR_CAL_DRAWS:-3} SAMPLES=${BTR_CAL_SAMPLES:-32} CELL=${BTR_CAL_CELL:-8}
 PRESET=${BTR_CAL_PRESET:-balanced}
+STIFFNESS=${BTR_CAL_STIFFNESS:-nominal}
+case "$STIFFNESS" in nominal|estimate) ;; *) echo "BTR_CAL_STIFFNESS: nominal or estimate, got '$STIFFNESS'" >&2; exit 2 ;; esac
 here=$(cd "$(dirname "$0")" && pwd)
 BIN=${BTR_BIN:-"$here/../build/ws/devel/lib/breast_tumour_registration"}  # BTR_BIN: another build
 mkdir -p "$OUT/phantoms"
@@ -25,7 +32,15 @@ if [ "$WHAT" = phantom ] || [ "$WHAT" = all ]; then
     d="$OUT/phantoms/E${E}_nu${NU}"
     [ -f "$d/scene.yaml" ] || "$BIN/btr_phantom" -o "$d" -E "$E" --poisson-ratio "$NU" --cell-size "$CELL" -q > "$d.log" 2>&1 \
       || { echo "phantom E=$E nu=$NU failed (see $d.log)"; continue; }
-    scenes+=("$d/scene.yaml")
+    if [ "$STIFFNESS" = estimate ]; then
+      # The phantom's frame: prone gravity +z (btr_phantom's scene says so in its `frame`).
+      sed -e '/^material:/,/^[a-z]/ s/^  youngs_modulus: 3400$/  youngs_modulus: estimate/' "$d/scene.yaml" > "$d/scene_estimated.yaml"
+      grep -q '^  youngs_modulus: estimate$' "$d/scene_estimated.yaml" || { echo "$d/scene.yaml: no 'youngs_modulus: 3400' to replace" >&2; exit 1; }
+      echo "prone_gravity: [0, 0, 9.81]" >> "$d/scene_estimated.yaml"
+      scenes+=("$d/scene_estimated.yaml")
+    else
+      scenes+=("$d/scene.yaml")
+    fi
   done < <(/usr/bin/python3 - "$BODIES" <<'PY'
 import random, sys
 n = int(sys.argv[1])
@@ -44,7 +59,9 @@ if [ "$WHAT" = independent ] || [ "$WHAT" = all ]; then
   # scene; then one CSV.
   data="$here/../test/data"
   for E in ${BTR_CAL_FAT:-1000 3400}; do
-    "$BIN/btr_calibration" "$data/independent_truth_E$E/scene_prone.yaml" "$data/independent_truth_E$E/scene_unloaded_regions.yaml" \
+    t="$data/independent_truth_E$E"
+    if [ "$STIFFNESS" = estimate ]; then sc=("$t/scene_estimated_regions.yaml"); else sc=("$t/scene_prone.yaml" "$t/scene_unloaded_regions.yaml"); fi
+    "$BIN/btr_calibration" "${sc[@]}" \
       --draws "$DRAWS" --samples "$SAMPLES" -p "$PRESET" -o "$OUT/independent_E$E" > "$OUT/independent_E$E.log" 2>&1 &
   done
   wait

@@ -109,6 +109,8 @@ void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions&
         row.linear_level = t.uncertainty ? probability_within(t.uncertainty->covariance, row.error) : nan;
         row.samples = su.samples;
         row.samples_not_converged = su.not_converged;
+        row.youngs_modulus = nominal.estimated_youngs_modulus > 0 ? nominal.estimated_youngs_modulus : scenes[si].material.youngs_modulus;
+        row.youngs_modulus_log_sd = nominal.estimated_youngs_modulus_log_sd;
         row.converged = nominal.converged;
         row.seconds = seconds;
         sink(row);
@@ -122,14 +124,14 @@ void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions&
 
 void write_calibration_csv_header(std::ostream& out) {
   out << "scene,draw,tumour,tilt_deg,error_mm,sampled_radius_95_mm,sampled_rank,linear_radius_95_mm,linear_level,samples,"
-         "samples_not_converged,converged,seconds\n";
+         "samples_not_converged,converged,seconds,youngs_modulus_Pa,youngs_modulus_log_sd\n";
 }
 
 void write_calibration_csv_row(std::ostream& out, const CalibrationRow& r) {
   out << csv_field(r.scene) << ',' << r.draw << ',' << csv_field(r.tumour) << ',' << std::setprecision(6) << r.tilt_deg << ',' << r.error * 1e3 << ','
       << r.sampled_radius_95 * 1e3 << ',' << r.sampled_rank << ',' << r.linear_radius_95 * 1e3 << ',' << r.linear_level << ','
       << r.samples << ',' << r.samples_not_converged << ',' << (r.converged ? 1 : 0) << ',' << std::setprecision(4) << r.seconds
-      << '\n';
+      << ',' << std::setprecision(6) << r.youngs_modulus << ',' << r.youngs_modulus_log_sd << '\n';
 }
 
 std::pair<double, double> wilson_interval(int k, int n) {

@@ -136,7 +136,9 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
     Json evaluations = Json::array();
     for (const auto& [E, misfit] : r.stiffness_evaluations)
       evaluations.push_back({{"youngs_modulus_Pa", num(E)}, {"landmark_misfit_mm", num(misfit * 1e3)}});
-    j["stiffness"] = {{"estimated_youngs_modulus_Pa", num(r.estimated_youngs_modulus)}, {"evaluations", evaluations}};
+    j["stiffness"] = {{"estimated_youngs_modulus_Pa", num(r.estimated_youngs_modulus)},
+                      {"log_sd", num(r.estimated_youngs_modulus_log_sd)},  // sd of ln E the landmarks leave (0: not known)
+                      {"evaluations", evaluations}};
   }
   Json seconds = {{"tetrahedralization", num(scene.tetrahedralize_seconds)}, {"prepare", num(prepare_seconds)}, {"rigid", num(r.rigid_seconds)}};
   for (const auto& s : r.reports) seconds[s.name] = num(s.seconds);

@@ -83,6 +83,10 @@ TEST(Calibration, WilsonIntervalAndObservedCoverageCountTheRowsAtEachLevel) {
   CalibrationOptions o;
   o.samples = 1;
   expect_throw_with<InputError>([&] { validate_calibration_options(o); }, "samples");
+  o.samples = 0;  // the linearised region alone
+  EXPECT_NO_THROW(validate_calibration_options(o));
+  o.linear = false;
+  expect_throw_with<InputError>([&] { validate_calibration_options(o); }, "samples");
 }
 
 // With every source held, every noisy copy is the scene itself: the same registration error
@@ -106,7 +110,20 @@ TEST(Calibration, WithoutSourcesEveryCopyIsTheScenesOwnRegistration) {
     EXPECT_LT(rows[i].sampled_radius_95, 1e-12);
     EXPECT_GT(rows[i].error, 1e-5);
     EXPECT_EQ(rows[i].sampled_rank, 1.0);  // every sample nearer than the truth
+    EXPECT_EQ(rows[i].youngs_modulus, s.material.youngs_modulus);  // told, not estimated
+    EXPECT_EQ(rows[i].youngs_modulus_log_sd, 0.0);
   }
+  // Without samples: the linearised region alone, the sampled one not computed.
+  o.samples = 0;
+  rows.clear();
+  run_calibration({s}, o, [&](const CalibrationRow& r) { rows.push_back(r); });
+  ASSERT_EQ(rows.size(), 2 * plain.tumours.size());
+  for (const CalibrationRow& r : rows) {
+    EXPECT_TRUE(std::isnan(r.sampled_rank) && std::isnan(r.sampled_radius_95));
+    EXPECT_EQ(r.samples, 0);
+    EXPECT_FALSE(std::isnan(r.linear_level));
+  }
+  EXPECT_EQ(observed_coverage(rows, 0.95, true).rows, 0);
   Scene no_truth = s;
   no_truth.tumours[0].supine_ground_truth.reset();
   expect_throw_with<InputError>([&] { run_calibration({no_truth}, o, [](const CalibrationRow&) {}); }, "supine_ground_truth");

@@ -166,6 +166,7 @@ TEST(MaterialRegions, AnEstimatedStiffnessScalesEveryRegion) {
   const double gland_E = j.at("materials")[1].at("youngs_modulus_Pa").get<double>();
   EXPECT_NEAR(gland_E / r.estimated_youngs_modulus, 2.0, 1e-9);
   EXPECT_DOUBLE_EQ(j.at("stiffness").at("estimated_youngs_modulus_Pa").get<double>(), r.estimated_youngs_modulus);
+  EXPECT_DOUBLE_EQ(j.at("stiffness").at("log_sd").get<double>(), r.estimated_youngs_modulus_log_sd);
 }
 
 // The uncertainty sampling and the stiffness search edit a prepared model's materials: scaling

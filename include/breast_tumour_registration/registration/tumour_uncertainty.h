@@ -11,7 +11,8 @@
 // dot product: dc/dp = -lambda^T dG/dp.
 //
 // Sources (uncertainty_sources.h; independent, Gaussian to first order): the Young's modulus of
-// every tissue together (ln E about the nominal, with the sd of the log-uniform range), the
+// every tissue together (ln E about the nominal, with the sd of the log-uniform range, or, where
+// the stiffness step estimated E, the sd the landmarks leave: StiffnessEstimate::log_sd), the
 // direction of gravity (a tilt about the two horizontal axes), and the supine surface's depth
 // noise (along its normal, per held skin vertex), and the rigid pose when the fit that set it
 // says how well it did (ICP on the rigid regions: IcpResult::pose_covariance; the supine data

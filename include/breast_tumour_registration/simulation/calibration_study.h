@@ -43,6 +43,10 @@ struct CalibrationRow {
   /// not computed).
   double linear_radius_95 = 0, linear_level = 0;
   int samples = 0, samples_not_converged = 0;
+  /// The method's Young's modulus [Pa] in the nominal registration (the stiffness step's estimate
+  /// where the scene asks for one, else the scene's), and the sd of ln E the landmarks leave
+  /// about an estimate (0: not estimated or not known).
+  double youngs_modulus = 0, youngs_modulus_log_sd = 0;
   bool converged = false;  ///< the nominal registration
   double seconds = 0;      ///< nominal registration and sampling
 };
