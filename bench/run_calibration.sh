@@ -56,12 +56,14 @@ PY
 fi
 if [ "$WHAT" = independent ] || [ "$WHAT" = all ]; then
   # One process per fat modulus (the two cores), each with the prone-as-rest and the unloaded
-  # scene; then one CSV.
+  # scene; then one CSV. One OpenMP thread each: two processes of two threads on two cores wait
+  # at every parallel loop's barrier for a thread the other process holds (a stiffness search:
+  # 28 s each side by side with the default threads, 12 s with one; BENCHMARKS.md).
   data="$here/../test/data"
   for E in ${BTR_CAL_FAT:-1000 3400}; do
     t="$data/independent_truth_E$E"
     if [ "$STIFFNESS" = estimate ]; then sc=("$t/scene_estimated_regions.yaml"); else sc=("$t/scene_prone.yaml" "$t/scene_unloaded_regions.yaml"); fi
-    "$BIN/btr_calibration" "${sc[@]}" \
+    OMP_NUM_THREADS=${OMP_NUM_THREADS:-1} "$BIN/btr_calibration" "${sc[@]}" \
       --draws "$DRAWS" --samples "$SAMPLES" -p "$PRESET" -o "$OUT/independent_E$E" > "$OUT/independent_E$E.log" 2>&1 &
   done
   wait
