@@ -25,8 +25,8 @@ def main():
     for path in sys.argv[1:]:
         with open(path) as f:
             for r in csv.DictReader(f):
-                key = (r["scene"], r["draw"])
-                per.setdefault(r["scene"], OrderedDict())[key] = (float(r["youngs_modulus_Pa"]), float(r["youngs_modulus_log_sd"]))
+                # One value per copy: its tumours' rows repeat it.
+                per.setdefault(r["scene"], OrderedDict())[r["draw"]] = (float(r["youngs_modulus_Pa"]), float(r["youngs_modulus_log_sd"]))
     print("| scene | true E | copies | median E | mean ln(E/E_true) | sd of ln E over copies | median sd(ln E) | rms z |")
     print("|---|---|---|---|---|---|---|---|")
     all_z = []

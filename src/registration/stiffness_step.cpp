@@ -162,8 +162,8 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     for (size_t i = 0; i < anchors.size(); ++i) predicted.row(static_cast<Eigen::Index>(i)) = anchors[i].position(x).transpose();
     const Rigid T = kabsch(supine, predicted);
     const Points fitted = transform_points(T, supine);
-    c.misfit = std::sqrt((fitted - predicted).rowwise().squaredNorm().mean());
     const Points r = fitted - predicted;
+    c.misfit = std::sqrt(r.rowwise().squaredNorm().mean());
     residuals.emplace_back(u, Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()));
     est.evaluations.emplace_back(E, c.misfit);
     return c;

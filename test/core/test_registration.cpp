@@ -65,12 +65,15 @@ std::string soft_phantom_dir(const std::string& name) {
   return d;
 }
 
-RegistrationResult register_scene(const std::string& path, const std::string& preset = "balanced") {
+RegistrationResult register_scene(const std::string& path, const RegistrationOptions& options) {
   const Scene s = load_meshed_scene(path);
   std::vector<std::string> warnings;
   const RegistrationModel m = prepare_model(s, warnings);
   EXPECT_TRUE(warnings.empty());
-  return run_registration(s, m, preset_options(preset));
+  return run_registration(s, m, options);
+}
+RegistrationResult register_scene(const std::string& path, const std::string& preset = "balanced") {
+  return register_scene(path, preset_options(preset));
 }
 
 
@@ -289,11 +292,9 @@ TEST(StepSelection, FollowsTheInputsAndNamesMissingFields) {
 TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   const std::string d = soft_phantom_dir("phantom12_soft_e");
   const std::string estimate = "material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]";
-  const Scene es = load_meshed_scene(scene_with(estimate, "estimate", d));
-  std::vector<std::string> prep_warnings;
   RegistrationOptions with_region = preset_options("balanced");
   with_region.uncertainty.enabled = true;  // the linearised region, to see it take the estimate's spread
-  const RegistrationResult r = run_registration(es, prepare_model(es, prep_warnings), with_region);
+  const RegistrationResult r = register_scene(scene_with(estimate, "estimate", d), with_region);
   ASSERT_GE(r.reports.size(), 2u);
   EXPECT_EQ(r.reports[0].name, "stiffness");
   EXPECT_EQ(r.reports[1].name, "unload");
