@@ -241,7 +241,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
       if (sample_e) scale_stiffness(m, youngs / model.material.youngs_modulus);
       if (src.samples_poisson_ratio()) set_poisson_ratio(m, nu);
       if (unload_each) {
-        set_rest_shape(m, m.prone, StepReport{});  // unload_model starts from (and may keep) the prone shape
+        set_rest_shape(m, m.prone, StepReport{}, Vec3::Zero());  // unload_model starts from (and may keep) the prone shape
         const StepReport u = unload_model(m, *scene.prone_gravity, unload_, &e.solvers);
         unload_kept_prone += !u.note.empty() && u.unload.rest_change == 0;
       }

@@ -290,6 +290,12 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
                                                                 uopt, pose_covariance);
       for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
       r.uncertainty_seconds = u.seconds;
+      if (u.rest_shape_follows) {
+        char b[160];
+        std::snprintf(b, sizeof b, "the unloaded rest shape moves with E and Poisson's ratio (%d GMRES products, %.2f s)",
+                      u.rest_response_iterations, u.rest_response_seconds);
+        notes.push_back(b);
+      }
       if (!u.note.empty()) notes.push_back(u.note);
       if (r.pose_solved_with_surface)
         notes.push_back("the rigid pose is held at its solution, but here it is solved with the deformation: on such a "

@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/blas_threads.h"
+#include "breast_tumour_registration/fem/gmres.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/spring_energy.h"
@@ -45,7 +47,110 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
   return p;
 }
 
+/// The model's materials with every tissue's Poisson's ratio set to `nu`, each keeping its
+/// Young's modulus (as set_poisson_ratio does).
+std::vector<StableNeoHookean> materials_at(const RegistrationModel& m, double nu) {
+  std::vector<StableNeoHookean> out;
+  for (const auto& mat : m.materials) out.emplace_back(mat.youngs_modulus(), nu);
+  return out;
+}
+
+/// The body's gradient at x from rest positions `rest` with `materials` (elastic), plus that of
+/// `gravity` when it is non-zero (its masses come from the rest volumes) [N], every vertex.
+Eigen::VectorXd body_gradient(const RegistrationModel& m, const Points& rest, const std::vector<StableNeoHookean>& materials,
+                              const Points& x, const Vec3& gravity) {
+  TotalEnergy e;
+  const TetMesh mesh{rest, m.rest.T};
+  add_elastic_energy(e, mesh, materials, m.material_of, m.volume_form);
+  if (gravity.norm() > 0) e.add(std::make_shared<GravityEnergy>(mesh, m.material.density, gravity));
+  return e.gradient(x);
+}
+
+/// d/dq of the elastic gradient at x (rest shape the model's), q the volume compliance, by a
+/// central difference in q kept inside (0, inf).
+Eigen::VectorXd elastic_gradient_d_compliance(const RegistrationModel& m, const Points& x) {
+  const double q0 = volume_compliance(m.material.poisson_ratio), h = 1e-3 * q0;
+  auto nu_of = [](double q) { return 1.0 / (2.0 * (1.0 + q)); };
+  return (body_gradient(m, m.rest.V, materials_at(m, nu_of(q0 + h)), x, Vec3::Zero()) -
+          body_gradient(m, m.rest.V, materials_at(m, nu_of(q0 - h)), x, Vec3::Zero())) /
+         (2 * h);
+}
+
+/// The directional derivative of the body's gradient at x in the rest positions, along dX
+/// (every vertex; zero rows stay put): a central difference moving no vertex more than 1 um.
+Eigen::VectorXd gradient_d_rest(const RegistrationModel& m, const Points& x, const Eigen::VectorXd& dX, const Vec3& gravity) {
+  const double largest = dX.cwiseAbs().maxCoeff();
+  if (!(largest > 0)) return Eigen::VectorXd::Zero(dX.size());
+  const double eps = 1e-6 / largest;
+  const Points D = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(dX.data(), dX.size() / 3, 3);
+  return (body_gradient(m, m.rest.V + eps * D, m.materials, x, gravity) -
+          body_gradient(m, m.rest.V - eps * D, m.materials, x, gravity)) /
+         (2 * eps);
+}
+
+/// How the unloaded rest shape X moves with each input p (its columns dG_p/dp: the prone
+/// gradient's partials at the imaged shape x_p, rest X). X is defined by G_p(x_p; X, p) = 0, so
+/// D_X G_p [dX/dp] = -dG_p/dp, with D_X G_p known only through differences of the gradient
+/// (gradient_d_rest). GMRES solves it, preconditioned by minus the prone elastic Hessian: for small
+/// strains moving the rest shape is moving the deformed one backwards, D_X G ~ -H, and the
+/// preconditioned operator is near the identity (this is the unload's fixed point, linearised).
+struct RestResponse {
+  std::vector<Eigen::VectorXd> dX;  ///< per input, every vertex (zero on the chest wall)
+  int iterations = 0;               ///< products with D_X G_p, over the inputs
+  double worst_residual = 0;        ///< the largest relative residual
+  bool converged = true;
+};
+
+RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& elastic,
+                                 const std::vector<Eigen::VectorXd>& dGp_dp) {
+  const int nv = static_cast<int>(m.rest.V.rows());
+  HessianAssembler Hp(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  llt.cholmod().print = 0;
+  elastic.hessian(m.prone, false, Hp);
+  llt.compute(Hp.matrix());
+  if (llt.info() != Eigen::Success) {  // only the preconditioner: the projected one serves too
+    elastic.hessian(m.prone, true, Hp);
+    llt.compute(Hp.matrix());
+    if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the prone Hessian cannot be factorized");
+  }
+  auto scatter = [&](const Eigen::VectorXd& reduced) {
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
+    Hp.scatter_add(reduced, 1.0, full);
+    return full;
+  };
+  auto apply_A = [&](const Eigen::VectorXd& v) {
+    return Eigen::VectorXd(Hp.gather(gradient_d_rest(m, m.prone, scatter(v), m.unloaded_under)));
+  };
+  auto apply_Minv = [&](const Eigen::VectorXd& r) { return Eigen::VectorXd(-llt.solve(r)); };
+  RestResponse out;
+  for (const Eigen::VectorXd& b : dGp_dp) {
+    Eigen::VectorXd y;
+    const GmresResult g = gmres(apply_A, apply_Minv, Eigen::VectorXd(-Hp.gather(b)), 1e-6, 60, y);
+    out.iterations += g.iterations;
+    out.worst_residual = std::max(out.worst_residual, g.relative_residual);
+    out.converged = out.converged && g.converged;
+    out.dX.push_back(scatter(y));
+  }
+  return out;
+}
+
 }  // namespace
+
+double volume_compliance(double nu) { return (1.0 - 2.0 * nu) / (2.0 * nu); }
+
+double volume_compliance_rms(const std::array<double, 2>& range, double nominal_nu) {
+  if (!(range[1] > 0)) return 0;
+  // Midpoint rule over the uniform range: exact enough for a distribution's second moment.
+  constexpr int n = 2000;
+  const double q0 = volume_compliance(nominal_nu);
+  double sum = 0;
+  for (int i = 0; i < n; ++i) {
+    const double nu = range[0] + (range[1] - range[0]) * (i + 0.5) / n;
+    sum += std::pow(volume_compliance(nu) - q0, 2);
+  }
+  return std::sqrt(sum / n);
+}
 
 void validate_uncertainty_options(const UncertaintyOptions& o) {
   validate_uncertainty_sources(o.sources);
@@ -142,11 +247,37 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the fixed point's Jacobian cannot be factorized");
   }
 
-  // Inputs' dG/dp on the free DOFs.
-  const Eigen::VectorXd b_E = H.gather(elastic.gradient(x));  // G_elastic is linear in E: dG/d ln E = G_elastic
+  // Inputs' dG/dp on the free DOFs. G_elastic is linear in E: dG/d ln E = G_elastic. Poisson's
+  // ratio enters through the volume compliance q = (1 - 2 nu) / (2 nu), in which the response
+  // is near linear (the volume stiffness is ~ mu / q), unlike in nu itself near 0.5.
+  const double sd_log_e = !opt.sources.samples_youngs_modulus() ? 0.0
+                          : opt.youngs_modulus_log_sd > 0    ? opt.youngs_modulus_log_sd
+                                                             : opt.sources.youngs_modulus_log_sd();
+  const double sd_q = volume_compliance_rms(opt.sources.poisson_ratio_range, model.material.poisson_ratio);
+  Eigen::VectorXd full_E = elastic.gradient(x);
+  Eigen::VectorXd full_q = sd_q > 0 ? elastic_gradient_d_compliance(model, x) : Eigen::VectorXd::Zero(3 * nv);
+  // An unloaded rest shape is the material's too: at another E or nu the prone image unloads to
+  // another shape, and the supine equilibrium moves with it, dG/dp += D_X G [dX/dp].
+  const bool gravity = surface.gravity && model.gravity.norm() > 0;
+  if (model.unloaded_under.norm() > 0 && (sd_log_e > 0 || sd_q > 0)) {
+    const auto t_rest = std::chrono::steady_clock::now();
+    const RestResponse rr = rest_shape_response(
+        model, elastic, {elastic.gradient(model.prone), sd_q > 0 ? elastic_gradient_d_compliance(model, model.prone) : Eigen::VectorXd::Zero(3 * nv)});
+    const Vec3 g_s = gravity ? model.gravity : Vec3::Zero();
+    full_E += gradient_d_rest(model, x, rr.dX[0], g_s);
+    if (sd_q > 0) full_q += gradient_d_rest(model, x, rr.dX[1], g_s);
+    out.rest_shape_follows = true;
+    out.rest_response_iterations = rr.iterations;
+    out.rest_response_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_rest).count();
+    if (!rr.converged) {
+      char b[200];
+      std::snprintf(b, sizeof b, "the rest shape's response to the material stopped at a relative residual of %.2g", rr.worst_residual);
+      out.note += (out.note.empty() ? "" : "; ") + std::string(b);
+    }
+  }
+  const Eigen::VectorXd b_E = H.gather(full_E), b_q = H.gather(full_q);
   Eigen::VectorXd b_g[2];
   std::array<Vec3, 2> axes = {Vec3::Zero(), Vec3::Zero()};
-  const bool gravity = surface.gravity && model.gravity.norm() > 0;
   if (gravity) {
     const GravityEnergy g(model.rest, model.material.density, model.gravity);
     axes = gravity_tilt_axes(model.gravity);
@@ -190,11 +321,9 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     const Eigen::MatrixXd lambda = llt.solve(R);  // free DOFs x 3
     TumourUncertainty u;
     u.d_log_youngs_modulus = R_s * Vec3(-lambda.transpose() * b_E);
-    const double sd_log_e = !opt.sources.samples_youngs_modulus() ? 0.0
-                            : opt.youngs_modulus_log_sd > 0    ? opt.youngs_modulus_log_sd
-                                                               : opt.sources.youngs_modulus_log_sd();
-    Mat3 cov_E = sd_log_e * sd_log_e * u.d_log_youngs_modulus *
-                 u.d_log_youngs_modulus.transpose();
+    const Mat3 cov_E = sd_log_e * sd_log_e * u.d_log_youngs_modulus * u.d_log_youngs_modulus.transpose();
+    u.d_volume_compliance = R_s * Vec3(-lambda.transpose() * b_q);
+    const Mat3 cov_q = sd_q * sd_q * u.d_volume_compliance * u.d_volume_compliance.transpose();
     Mat3 cov_g = Mat3::Zero();
     if (gravity)
       for (int k = 0; k < 2; ++k) {
@@ -218,8 +347,8 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       u.d_pose.col(k) = R_s * (Vec3(-lambda.transpose() * b_pose[k]) - moved_back);
     }
     const Mat3 cov_p = pose_covariance ? Mat3(u.d_pose * *pose_covariance * u.d_pose.transpose()) : Mat3::Zero();
-    u.covariance = cov_E + cov_g + cov_d + cov_p;
-    u.sources = {{"youngs_modulus", cov_E}, {"gravity_direction", cov_g}, {"depth_noise", cov_d}};
+    u.covariance = cov_E + cov_q + cov_g + cov_d + cov_p;
+    u.sources = {{"youngs_modulus", cov_E}, {"poisson_ratio", cov_q}, {"gravity_direction", cov_g}, {"depth_noise", cov_d}};
     if (pose_covariance) u.sources.emplace_back("rigid_pose", cov_p);
     u.radius_95 = radius_95(u.covariance);
     out.tumours.push_back(u);

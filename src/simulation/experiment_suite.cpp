@@ -300,7 +300,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
                   format_value(u.unload.mismatch * 1e3) + " mm, " + format_value(u.seconds) + " s" +
                   (u.note.empty() ? "" : "; " + u.note));
             } else {
-              set_rest_shape(rm, it->second.first, it->second.second);
+              set_rest_shape(rm, it->second.first, it->second.second, *scene.prone_gravity);
             }
             unload_seconds = it->second.second.seconds;
           }

@@ -91,7 +91,9 @@ Json tumour_report(const TumourResult& t, const SampledUncertainty* sampled, siz
                         {"radius_95_mm", num(u.radius_95 * 1e3)},
                         {"covariance_mm2", mat(u.covariance, 1e6)},
                         {"rms_mm_by_source", by_source},
-                        {"d_centroid_d_ln_youngs_modulus_mm", vec_mm(u.d_log_youngs_modulus)}};
+                        {"d_centroid_d_ln_youngs_modulus_mm", vec_mm(u.d_log_youngs_modulus)},
+                        // q = (1 - 2 nu) / (2 nu), the variable Poisson's ratio is linearised in
+                        {"d_centroid_d_volume_compliance_mm", vec_mm(u.d_volume_compliance)}};
   }
   if (sampled && i < sampled->tumours.size()) {
     const auto& u = sampled->tumours[i];

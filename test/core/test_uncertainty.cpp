@@ -15,6 +15,7 @@
 #include "breast_tumour_registration/geometry/margin_shell.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
+#include "breast_tumour_registration/registration/unload_step.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
@@ -28,6 +29,52 @@ using btr::test::expect_throw_with;
 
 namespace {
 
+/// The minimum of the surface step's last Newton problem with these held skin targets (moved
+/// rigidly by `move`), the model's material and rest shape, and `gravity`: solved to round-off
+/// from `start`.
+Points held_energy_minimum(const RegistrationModel& m, const std::vector<HeldSkinVertex>& held, const Rigid& move,
+                           const Vec3& gravity, const SurfaceStepOptions& surface, const Points& start) {
+  TotalEnergy energy;
+  add_model_elastic_energy(energy, m);
+  energy.add(std::make_shared<GravityEnergy>(m.rest, m.material.density, gravity));
+  auto springs = std::make_shared<SpringEnergy>();
+  for (const HeldSkinVertex& k : held)
+    springs->add_point_and_plane(Anchor::vertex(k.vertex), move * k.point, move.linear() * k.normal, surface.point_weight,
+                                 surface.plane_weight);
+  energy.add(springs);
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.rest.V.rows()), m.rest.T, m.fixed,
+                                                         energy.hessian_cliques()),
+                      m.rest.T);
+  NewtonOptions n;
+  n.gradient_rel_tolerance = 1e-13;
+  n.gradient_abs_tolerance = 1e-13;
+  n.step_tolerance = 1e-15;
+  n.reuse_factorization = false;
+  Points x = start;
+  const NewtonResult nr = solver.solve(energy, x, n);
+  // Tolerances far below round-off: a stall at 1e-8 N of a 3 N weight is the minimum too.
+  EXPECT_TRUE(nr.converged || nr.gradient_norm < 1e-6) << to_string(nr.reason) << ", gradient " << nr.gradient_norm << " N after " << nr.iterations;
+  return x;
+}
+
+/// The tumours' volume centroids at x, model frame.
+std::vector<Vec3> tumour_centroids(const RegistrationModel& m, const Points& x) {
+  std::vector<Vec3> c;
+  for (const auto& t : m.tumours) c.push_back(volume_centroid({apply_embedding(t.embedding, m.rest.T, x), t.prone.F}));
+  return c;
+}
+
+/// The skin vertices the supine surface (in the model frame) holds at x, as the linearisation takes them.
+std::vector<HeldSkinVertex> held_skin(const RegistrationModel& model, const Points& x, const SurfaceProjector& supine,
+                                      const SurfaceStepOptions& surface) {
+  std::vector<HeldSkinVertex> held;
+  for (int v : model.skin) {
+    const Projection c = supine.project(Vec3(x.row(v).transpose()));
+    if (!holds_projection(c, surface)) continue;
+    held.push_back({v, c.point, c.normal.normalized()});
+  }
+  return held;
+}
 
 }  // namespace
 
@@ -108,40 +155,15 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
   const Rigid& T = r.supine_to_model;
   const auto supine = make_mesh_projector(transform_surface(T, *s.supine_surface));
   // The held targets at the result, as the linearisation takes them.
-  std::vector<HeldSkinVertex> held;
-  for (int v : model.skin) {
-    const Projection c = supine->project(Vec3(r.x.row(v).transpose()));
-    if (!holds_projection(c, o.surface)) continue;
-    held.push_back({v, c.point, c.normal.normalized()});
-  }
+  const std::vector<HeldSkinVertex> held = held_skin(model, r.x, *supine, o.surface);
   // move: a rigid motion of the supine data in the model frame (the pose supine -> model becomes
   // move * T); the centroids come back through that pose.
   auto resolve = [&](double log_e, const Vec3& gravity, const Rigid& move = Rigid::Identity()) {
     RegistrationModel m = model;
     scale_stiffness(m, std::exp(log_e));
-    TotalEnergy energy;
-    add_model_elastic_energy(energy, m);
-    energy.add(std::make_shared<GravityEnergy>(m.rest, m.material.density, gravity));
-    auto springs = std::make_shared<SpringEnergy>();
-    for (const HeldSkinVertex& k : held)
-      springs->add_point_and_plane(Anchor::vertex(k.vertex), move * k.point, move.linear() * k.normal, o.surface.point_weight,
-                                   o.surface.plane_weight);
-    energy.add(springs);
-    NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.rest.V.rows()), m.rest.T, m.fixed,
-                                                           energy.hessian_cliques()),
-                        m.rest.T);
-    NewtonOptions n;
-    n.gradient_rel_tolerance = 1e-13;
-    n.gradient_abs_tolerance = 1e-13;
-    n.step_tolerance = 1e-15;
-    n.reuse_factorization = false;
-    Points x = r.x;
-    const NewtonResult nr = solver.solve(energy, x, n);
-    // Tolerances far below round-off: a stall at 1e-8 N of a 3 N weight is the minimum too.
-    EXPECT_TRUE(nr.converged || nr.gradient_norm < 1e-6) << to_string(nr.reason) << ", gradient " << nr.gradient_norm << " N after " << nr.iterations;
-    std::vector<Vec3> c;
-    for (const auto& t : m.tumours)
-      c.push_back((move * T).inverse() * volume_centroid({apply_embedding(t.embedding, m.rest.T, x), t.prone.F}));
+    const Points x = held_energy_minimum(m, held, move, gravity, o.surface, r.x);
+    std::vector<Vec3> c = tumour_centroids(m, x);
+    for (Vec3& ci : c) ci = (move * T).inverse() * ci;
     return std::make_pair(x, c);
   };
   // The balanced result is near, not at, this energy's minimum (its held projections are those
@@ -183,6 +205,78 @@ TEST(Uncertainty, HeldProjectionSensitivitiesMatchReSolvesOfThatEnergy) {
                   1e3 * lin_k.x(), 1e3 * lin_k.y(), 1e3 * lin_k.z(), 1e3 * fd.x(), 1e3 * fd.y(), 1e3 * fd.z(), k < 3 ? "rad" : "m");
       EXPECT_LT((lin_k - fd).norm(), 0.03 * fd.norm() + 1e-6) << r.tumours[i].name << " pose " << k;
     }
+  }
+}
+
+// Poisson's ratio, and an unloaded rest shape moving with the material. On a model unloaded
+// under the prone gravity, E and nu are perturbed, the prone image unloaded again (to 1e-9 m)
+// and the held energy re-solved: the linearised sensitivities (the rest shape's response from
+// the unload's own equation, by GMRES) must match, and must differ from the response with the
+// rest shape held (else this test could not see the rest shape's part).
+TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFollowsIt) {
+  Scene s = btr::test::coarse_phantom_scene();
+  s.prone_gravity = Vec3(0, 0, 9.81);  // the phantom's prone gravity (its scene's `frame`)
+  RegistrationOptions o = preset_options("balanced");
+  o.uncertainty.enabled = true;
+  o.uncertainty.held_projections = true;
+  RegistrationEngine engine(s);
+  const RegistrationResult r = engine.solve(o);
+  ASSERT_TRUE(r.converged) << btr::test::step_stops(r);
+  const RegistrationModel& model = engine.prepare(o).model;
+  ASSERT_GT(model.unloaded_under.norm(), 0.0) << "the model was not unloaded";
+  const Rigid& T = r.supine_to_model;
+  const auto supine = make_mesh_projector(transform_surface(T, *s.supine_surface));
+  const std::vector<HeldSkinVertex> held = held_skin(model, r.x, *supine, o.surface);
+  const Points x0 = held_energy_minimum(model, held, Rigid::Identity(), model.gravity, o.surface, r.x);
+  const UncertaintyResult lin = linearised_tumour_uncertainty(model, x0, held, T.inverse(), o.surface, o.uncertainty);
+  EXPECT_TRUE(lin.rest_shape_follows);
+  EXPECT_TRUE(lin.note.empty()) << lin.note;
+  std::printf("rest shape's response: %d GMRES products, %.2f s of %.2f s\n", lin.rest_response_iterations,
+              lin.rest_response_seconds, lin.seconds);
+  const double q0 = volume_compliance(model.material.poisson_ratio);
+  auto resolve = [&](double log_e, double dq, bool unload) {
+    RegistrationModel m = model;
+    scale_stiffness(m, std::exp(log_e));
+    set_poisson_ratio(m, 1.0 / (2.0 * (1.0 + q0 + dq)));
+    if (unload) {
+      const TetMesh loaded{m.prone, m.rest.T};
+      UnloadProblem pb = unload_problem(m, loaded, model.unloaded_under);
+      pb.initial_rest = &model.rest.V;
+      UnloadOptions uo;
+      uo.tolerance = 1e-9;
+      uo.max_iterations = 80;
+      uo.forward.newton.gradient_rel_tolerance = 1e-12;
+      uo.forward.newton.gradient_abs_tolerance = 1e-12;
+      uo.forward.newton.step_tolerance = 1e-14;
+      const UnloadResult u = estimate_unloaded_shape(pb, uo);
+      EXPECT_TRUE(u.converged) << u.stop_reason;
+      set_rest_shape(m, u.rest, unload_report(u, m.prone), model.unloaded_under);
+    }
+    std::vector<Vec3> c = tumour_centroids(m, held_energy_minimum(m, held, Rigid::Identity(), model.gravity, o.surface, x0));
+    for (Vec3& ci : c) ci = T.inverse() * ci;
+    return c;
+  };
+  const double h_e = 0.02, h_q = 0.05 * q0;
+  const auto e_up = resolve(h_e, 0, true), e_down = resolve(-h_e, 0, true);
+  const auto q_up = resolve(0, h_q, true), q_down = resolve(0, -h_q, true);
+  const auto e_up_held = resolve(h_e, 0, false), e_down_held = resolve(-h_e, 0, false);
+  const auto q_up_held = resolve(0, h_q, false), q_down_held = resolve(0, -h_q, false);
+  ASSERT_EQ(lin.tumours.size(), r.tumours.size());
+  for (size_t i = 0; i < r.tumours.size(); ++i) {
+    const TumourUncertainty& u = lin.tumours[i];
+    const Vec3 fd_e = (e_up[i] - e_down[i]) / (2 * h_e), fd_q = (q_up[i] - q_down[i]) / (2 * h_q);
+    const Vec3 held_e = (e_up_held[i] - e_down_held[i]) / (2 * h_e), held_q = (q_up_held[i] - q_down_held[i]) / (2 * h_q);
+    std::printf("%-7s dc/dlnE linear (%.4f %.4f %.4f) re-solved (%.4f %.4f %.4f) rest held (%.4f %.4f %.4f) mm\n",
+                r.tumours[i].name.c_str(), 1e3 * u.d_log_youngs_modulus.x(), 1e3 * u.d_log_youngs_modulus.y(),
+                1e3 * u.d_log_youngs_modulus.z(), 1e3 * fd_e.x(), 1e3 * fd_e.y(), 1e3 * fd_e.z(), 1e3 * held_e.x(),
+                1e3 * held_e.y(), 1e3 * held_e.z());
+    std::printf("%-7s dc/dq    linear (%.4f %.4f %.4f) re-solved (%.4f %.4f %.4f) rest held (%.4f %.4f %.4f) mm\n",
+                r.tumours[i].name.c_str(), 1e3 * u.d_volume_compliance.x(), 1e3 * u.d_volume_compliance.y(),
+                1e3 * u.d_volume_compliance.z(), 1e3 * fd_q.x(), 1e3 * fd_q.y(), 1e3 * fd_q.z(), 1e3 * held_q.x(),
+                1e3 * held_q.y(), 1e3 * held_q.z());
+    EXPECT_LT((u.d_log_youngs_modulus - fd_e).norm(), 0.03 * fd_e.norm()) << r.tumours[i].name;
+    EXPECT_LT((u.d_volume_compliance - fd_q).norm(), 0.05 * fd_q.norm()) << r.tumours[i].name;
+    EXPECT_GT((fd_e - held_e).norm(), 0.2 * fd_e.norm()) << r.tumours[i].name << ": the rest shape's part is not seen";
   }
 }
 
@@ -250,7 +344,7 @@ TEST(Uncertainty, AGivenPoseWithItsCovarianceIsLinearisedAndSampled) {
   ASSERT_EQ(su.samples, 24);
   for (size_t i = 0; i < r.tumours.size(); ++i) {
     const TumourUncertainty& u = *r.tumours[i].uncertainty;
-    ASSERT_EQ(u.sources.size(), 4u);
+    ASSERT_EQ(u.sources.size(), 5u);
     EXPECT_EQ(u.sources.back().first, "rigid_pose");
     const double linear = std::sqrt(u.covariance.trace()), sampled = std::sqrt(su.tumours[i].covariance.trace());
     std::printf("%-7s pose alone: RMS spread linear %.3f mm, sampled %.3f mm (24 samples), ratio %.2f\n",

@@ -25,8 +25,8 @@ struct UncertaintySources {
   /// fat / gland / muscle at 0.45 to 1.8 kPa). Every tissue is scaled together, keeping the
   /// regions' ratios. {0, 0}: held at the nominal value.
   std::array<double, 2> youngs_modulus_range{200, 3000};
-  /// Poisson's ratio, uniform over this range (sampling only; the linearisation holds it).
-  /// {0, 0}: held.
+  /// Poisson's ratio, uniform over this range (the linearisation takes the volume compliance's
+  /// spread about the nominal over it: tumour_uncertainty.h). {0, 0}: held.
   std::array<double, 2> poisson_ratio_range{0.45, 0.499};
   double gravity_direction_deg = 2.0;  ///< sd of the supine gravity's tilt about each horizontal axis [deg]
   double landmark_sd = 0.0015;         ///< sd of each supine landmark's position, per axis [m] (sampling only)

@@ -88,6 +88,10 @@ struct RegistrationModel {
   /// regions were given on. Equal to rest.V unless unloaded. (Registrations start from rest.V.)
   Points prone;
   std::optional<StepReport> unload;  ///< the unload step's report, when the rest shape was estimated
+  /// The gravity the rest shape was unloaded under, model frame [m/s^2]; zero when the rest
+  /// shape is the prone shape. An unloaded rest shape moves with the material (the linear
+  /// region follows it: tumour_uncertainty.h).
+  Vec3 unloaded_under = Vec3::Zero();
   std::vector<int> chest_wall;     ///< fixed vertices
   std::vector<bool> fixed;         ///< #V flags
   std::vector<int> skin;           ///< boundary vertices that are not fixed

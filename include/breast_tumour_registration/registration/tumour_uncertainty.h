@@ -12,15 +12,22 @@
 //
 // Sources (uncertainty_sources.h; independent, Gaussian to first order): the Young's modulus of
 // every tissue together (ln E about the nominal, with the sd of the log-uniform range, or, where
-// the stiffness step estimated E, the sd the landmarks leave: StiffnessEstimate::log_sd), the
+// the stiffness step estimated E, the sd the landmarks leave: StiffnessEstimate::log_sd),
+// Poisson's ratio of every tissue together (linearised in the volume compliance
+// q = (1 - 2 nu) / (2 nu), in which the response is near linear, with q's root mean square
+// about the nominal over the uniform range: the range need not be centred on the nominal), the
 // direction of gravity (a tilt about the two horizontal axes), and the supine surface's depth
 // noise (along its normal, per held skin vertex), and the rigid pose when the fit that set it
 // says how well it did (ICP on the rigid regions: IcpResult::pose_covariance; the supine data
-// move rigidly in the model frame, the chest wall stays). Not covered by the linearisation: the
-// landmarks' localisation and the landmark step's influence on where the surface step ends (it
-// is a start, not an input, of the equilibrium), a pose solved with the landmarks or the skin
-// (held at its solution), Poisson's ratio, and model error beyond these inputs. Sampling (RegistrationEngine::
-// sample_uncertainty) draws every source, the landmarks and Poisson's ratio included.
+// move rigidly in the model frame, the chest wall stays). Where the rest shape is an unloaded
+// one (RegistrationModel::unloaded_under) it moves with E and nu too: dX/dp from the unload's
+// own equation, G_prone(x_prone; X, p) = 0, by GMRES on differences of the gradient in X; its
+// effect joins dG/dp. Not covered by the linearisation: the landmarks' localisation (except
+// through an estimated E's sd) and the landmark step's influence on where the surface step ends
+// (it is a start, not an input, of the equilibrium), a pose solved with the landmarks or the skin
+// (held at its solution), E's estimate compensating a wrong Poisson's ratio (the two are taken
+// as independent), and model error beyond these inputs. Sampling (RegistrationEngine::
+// sample_uncertainty) draws every source, the landmarks included.
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
 // exact: against re-solves of the energy it differentiates (held projections) it agrees within
@@ -48,8 +55,9 @@ namespace btr {
 struct UncertaintyOptions {
   bool enabled = false;
   /// The inputs' distributions (uncertainty_sources.h; a scene's `uncertainty:` section). The
-  /// linearisation takes ln E about the nominal modulus with the range's sd, the gravity tilt
-  /// and the depth noise; sampling draws every source.
+  /// linearisation takes ln E about the nominal modulus with the range's sd, Poisson's ratio
+  /// (as its volume compliance), the gravity tilt and the depth noise; sampling draws every
+  /// source.
   UncertaintySources sources;
   /// false: linearise the surface step's fixed point as its sliding option has it (held along
   /// the scan where it settled, or free to slide).
@@ -73,6 +81,8 @@ struct TumourUncertainty {
   /// Sensitivities of the centroid (supine frame): per unit ln E [m], per radian of gravity tilt
   /// about the model frame's two horizontal axes [m/rad].
   Vec3 d_log_youngs_modulus = Vec3::Zero();
+  /// per unit of the volume compliance q = (1 - 2 nu) / (2 nu) [m] (volume_compliance)
+  Vec3 d_volume_compliance = Vec3::Zero();
   Vec3 d_gravity_tilt[2] = {Vec3::Zero(), Vec3::Zero()};
   /// Per unit of a small rigid motion xi = (omega [rad], tau [m]) of the supine data in the model
   /// frame (supine -> model becomes exp(xi) of it; IcpResult::pose_covariance): the skin follows
@@ -84,7 +94,20 @@ struct UncertaintyResult {
   std::vector<TumourUncertainty> tumours;  ///< as model.tumours
   std::string note;                        ///< what the linearisation assumed or could not do
   double seconds = 0;
+  /// The unloaded rest shape's response to E and nu was included (the model was unloaded), in
+  /// this many GMRES products with the prone gradient's rest-shape derivative and this time [s].
+  bool rest_shape_follows = false;
+  int rest_response_iterations = 0;
+  double rest_response_seconds = 0;
 };
+
+/// The volume compliance q = mu / lambda_L = (1 - 2 nu) / (2 nu) of Poisson's ratio nu: the
+/// variable the linearisation takes Poisson's ratio in (0 at incompressibility).
+double volume_compliance(double nu);
+
+/// sqrt(E[(q(nu) - q(nominal_nu))^2]) for nu uniform over `range` (0 when the range is {0, 0}:
+/// held): the spread of the true compliance about the method's.
+double volume_compliance_rms(const std::array<double, 2>& range, double nominal_nu);
 
 /// A skin vertex held on the supine surface: its target point and unit normal (model frame).
 struct HeldSkinVertex {

@@ -32,8 +32,9 @@ UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& load
 StepReport unload_report(const UnloadResult& unload, const Points& prone);
 
 /// Makes `rest` (an unloaded shape found before, e.g. cached) the rest shape of `model`,
-/// recording `report` as its unload step. Throws InputError when the size does not match or an
-/// element of it is inverted.
-void set_rest_shape(RegistrationModel& model, const Points& rest, const StepReport& report);
+/// recording `report` as its unload step and `unloaded_under` as the gravity it was unloaded
+/// under (zero: `rest` is not an unloaded shape, e.g. the prone shape itself). Throws InputError
+/// when the size does not match or an element of it is inverted.
+void set_rest_shape(RegistrationModel& model, const Points& rest, const StepReport& report, const Vec3& unloaded_under);
 
 }  // namespace btr
