@@ -286,10 +286,19 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
         }
         notes.push_back(b);
       }
+      // An estimated E follows a Poisson's ratio other than the method's (the landmarks it was fitted on).
+      std::optional<LandmarkStiffnessFit> fit;
+      if (r.stiffness_prediction.rows() > 0) fit = LandmarkStiffnessFit{scene.landmark_anchors, r.stiffness_prediction};
       const UncertaintyResult u = linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed,
-                                                                uopt, pose_covariance);
+                                                                uopt, pose_covariance, fit ? &*fit : nullptr);
       for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
       r.uncertainty_seconds = u.seconds;
+      if (u.estimate_follows_poisson_ratio) {
+        char b[160];
+        std::snprintf(b, sizeof b, "the estimated E follows Poisson's ratio through the landmarks (d ln E / d q = %.3g)",
+                      u.log_youngs_modulus_per_compliance);
+        notes.push_back(b);
+      }
       if (u.rest_shape_follows) {
         char b[160];
         std::snprintf(b, sizeof b, "the unloaded rest shape moves with E and Poisson's ratio (%d GMRES products, %.2f s)",

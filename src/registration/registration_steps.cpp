@@ -38,6 +38,7 @@ class StiffnessStep : public RegistrationStep {
     c.result.estimated_youngs_modulus = est.youngs_modulus;
     c.result.stiffness_evaluations = est.evaluations;
     c.result.estimated_youngs_modulus_log_sd = est.log_sd(c.opt.uncertainty.sources.landmark_sd);
+    c.result.stiffness_prediction = est.supine_prediction;
   }
 };
 

@@ -102,6 +102,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     double misfit = std::numeric_limits<double>::infinity();
     Points rest;
     UnloadResult unload;
+    Points supine;  ///< its gravity-only supine equilibrium
   };
   // Every simulated candidate's log E and Kabsch-fitted landmark residual (3n): the residual's
   // slope at the estimate says how well the landmarks fix E (StiffnessEstimate::log_sd).
@@ -158,6 +159,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
       return c;
     }
     last_supine = Supine{u, x - c.rest};
+    c.supine = x;
     Points predicted(static_cast<Eigen::Index>(anchors.size()), 3);
     for (size_t i = 0; i < anchors.size(); ++i) predicted.row(static_cast<Eigen::Index>(i)) = anchors[i].position(x).transpose();
     const Rigid T = kabsch(supine, predicted);
@@ -276,6 +278,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   est.landmarks = static_cast<int>(anchors.size());
   est.landmark_sensitivity = residual_slope(residuals, u_best);
   est.rest = c_best.rest;
+  est.supine_prediction = c_best.supine;
   est.unload = c_best.unload;
   est.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return est;

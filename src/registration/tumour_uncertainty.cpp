@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -135,6 +136,57 @@ RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& 
   return out;
 }
 
+bool fit_usable(const LandmarkStiffnessFit& fit, int nv) {
+  return fit.anchors.size() >= 3 && fit.supine_prediction.rows() == nv && fit.supine_prediction.allFinite();
+}
+
+/// d ln E / d q of the stiffness step's landmark fit (LandmarkStiffnessFit): the supine
+/// gravity-only prediction's response to ln E and to q (the rest shape's part included: dX_rest,
+/// empty when the rest shape is the prone one), its landmarks' motion, the part of it no rigid
+/// motion of the landmarks explains (the fit re-fits the pose: Kabsch), and the Gauss-Newton
+/// step of ln E that fits them again.
+double per_compliance(const RegistrationModel& m, const TotalEnergy& elastic, const LandmarkStiffnessFit& fit,
+                      const std::vector<Eigen::VectorXd>& dX_rest) {
+  const int nv = static_cast<int>(m.rest.V.rows());
+  const Points& xg = fit.supine_prediction;
+  HessianAssembler Hg(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  llt.cholmod().print = 0;
+  elastic.hessian(xg, false, Hg);
+  llt.compute(Hg.matrix());
+  if (llt.info() != Eigen::Success) {
+    elastic.hessian(xg, true, Hg);
+    llt.compute(Hg.matrix());
+    if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the stiffness prediction's Hessian cannot be factorized");
+  }
+  const int n = static_cast<int>(fit.anchors.size());
+  auto landmark_motion = [&](Eigen::VectorXd partial, int input) {
+    if (!dX_rest.empty()) partial += gradient_d_rest(m, xg, dX_rest[input], m.gravity);
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
+    Hg.scatter_add(llt.solve(Hg.gather(partial)), -1.0, full);
+    const Points d = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(full.data(), nv, 3);
+    Eigen::VectorXd l(3 * n);
+    for (int i = 0; i < n; ++i) l.segment<3>(3 * i) = fit.anchors[i].position(d);
+    return l;
+  };
+  Eigen::VectorXd l_E = landmark_motion(elastic.gradient(xg), 0);
+  Eigen::VectorXd l_q = landmark_motion(elastic_gradient_d_compliance(m, xg), 1);
+  // The landmarks' small rigid motions about their centroid: translations, and e_k x (p - c).
+  Eigen::MatrixXd B(3 * n, 6);
+  Vec3 c = Vec3::Zero();
+  for (int i = 0; i < n; ++i) c += fit.anchors[i].position(xg) / n;
+  for (int i = 0; i < n; ++i) {
+    const Vec3 r = fit.anchors[i].position(xg) - c;
+    B.block<3, 3>(3 * i, 0) = Mat3::Identity();
+    for (int k = 0; k < 3; ++k) B.block<3, 1>(3 * i, 3 + k) = Vec3::Unit(k).cross(r);
+  }
+  const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(B).householderQ() * Eigen::MatrixXd::Identity(3 * n, 6);
+  l_E -= Q * (Q.transpose() * l_E);
+  l_q -= Q * (Q.transpose() * l_q);
+  if (!(l_E.squaredNorm() > 0)) return 0;
+  return -l_E.dot(l_q) / l_E.squaredNorm();
+}
+
 }  // namespace
 
 double volume_compliance(double nu) { return (1.0 - 2.0 * nu) / (2.0 * nu); }
@@ -150,6 +202,18 @@ double volume_compliance_rms(const std::array<double, 2>& range, double nominal_
     sum += std::pow(volume_compliance(nu) - q0, 2);
   }
   return std::sqrt(sum / n);
+}
+
+double log_youngs_modulus_per_compliance(const RegistrationModel& model, const LandmarkStiffnessFit& fit) {
+  const int nv = static_cast<int>(model.rest.V.rows());
+  if (!fit_usable(fit, nv))
+    throw InputError("uncertainty: the stiffness fit needs >= 3 landmarks and a finite prediction of every vertex");
+  TotalEnergy elastic;
+  add_model_elastic_energy(elastic, model);
+  std::vector<Eigen::VectorXd> dX_rest;
+  if (model.unloaded_under.norm() > 0)
+    dX_rest = rest_shape_response(model, elastic, {elastic.gradient(model.prone), elastic_gradient_d_compliance(model, model.prone)}).dX;
+  return per_compliance(model, elastic, fit, dX_rest);
 }
 
 void validate_uncertainty_options(const UncertaintyOptions& o) {
@@ -193,7 +257,8 @@ double radius_95(const Mat3& covariance) {
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
-                                                const UncertaintyOptions& opt, const std::optional<Mat6>& pose_covariance) {
+                                                const UncertaintyOptions& opt, const std::optional<Mat6>& pose_covariance,
+                                                const LandmarkStiffnessFit* stiffness_fit) {
   std::vector<HeldSkinVertex> held;
   const Mat3 R_p = model_to_projector.linear();
   const Rigid to_model = model_to_projector.inverse();
@@ -202,13 +267,14 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     if (!holds_projection(c, surface)) continue;
     held.push_back({v, to_model * c.point, (R_p.transpose() * c.normal).normalized()});
   }
-  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt, pose_covariance);
+  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt, pose_covariance, stiffness_fit);
 }
 
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
                                                 const SurfaceStepOptions& surface, const UncertaintyOptions& opt,
-                                                const std::optional<Mat6>& pose_covariance) {
+                                                const std::optional<Mat6>& pose_covariance,
+                                                const LandmarkStiffnessFit* stiffness_fit) {
   validate_uncertainty_options(opt);
   const auto t0 = std::chrono::steady_clock::now();
   UncertaintyResult out;
@@ -259,10 +325,12 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // An unloaded rest shape is the material's too: at another E or nu the prone image unloads to
   // another shape, and the supine equilibrium moves with it, dG/dp += D_X G [dX/dp].
   const bool gravity = surface.gravity && model.gravity.norm() > 0;
+  std::vector<Eigen::VectorXd> dX_rest;  // per input (ln E, q); empty: the rest shape is the prone one
   if (model.unloaded_under.norm() > 0 && (sd_log_e > 0 || sd_q > 0)) {
     const auto t_rest = std::chrono::steady_clock::now();
     const RestResponse rr = rest_shape_response(
         model, elastic, {elastic.gradient(model.prone), sd_q > 0 ? elastic_gradient_d_compliance(model, model.prone) : Eigen::VectorXd::Zero(3 * nv)});
+    dX_rest = rr.dX;
     const Vec3 g_s = gravity ? model.gravity : Vec3::Zero();
     full_E += gradient_d_rest(model, x, rr.dX[0], g_s);
     if (sd_q > 0) full_q += gradient_d_rest(model, x, rr.dX[1], g_s);
@@ -274,6 +342,12 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       std::snprintf(b, sizeof b, "the rest shape's response to the material stopped at a relative residual of %.2g", rr.worst_residual);
       out.note += (out.note.empty() ? "" : "; ") + std::string(b);
     }
+  }
+  // E estimated from the landmarks follows a true nu other than the method's.
+  if (stiffness_fit && sd_q > 0 && fit_usable(*stiffness_fit, nv)) {
+    out.log_youngs_modulus_per_compliance = per_compliance(model, elastic, *stiffness_fit, dX_rest);
+    out.estimate_follows_poisson_ratio = true;
+    full_q += out.log_youngs_modulus_per_compliance * full_E;
   }
   const Eigen::VectorXd b_E = H.gather(full_E), b_q = H.gather(full_q);
   Eigen::VectorXd b_g[2];

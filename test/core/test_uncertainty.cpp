@@ -280,6 +280,45 @@ TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFoll
   }
 }
 
+// Where E is estimated from the landmarks, a true Poisson's ratio other than the method's moves
+// the estimate: the landmarks' gravity-only prediction moves with nu, and the search re-fits E.
+// The linearisation's d ln E / d q against stiffness searches re-run (tightly) at nu on either
+// side, on the coarse phantom unloaded at its estimate.
+TEST(Uncertainty, TheEstimatedStiffnessFollowsPoissonsRatioAsTheLandmarksAreRefitted) {
+  const Scene& s = btr::test::coarse_phantom_scene();
+  std::vector<std::string> w;
+  const RegistrationModel model = prepare_model(s, w);
+  const Vec3 g(0, 0, 9.81);  // the phantom's prone gravity
+  StiffnessOptions so;
+  so.min_youngs_modulus = 500;
+  so.max_youngs_modulus = 20000;
+  so.relative_tolerance = 1e-5;
+  so.max_refinements = 60;
+  so.candidate_tolerance = 1e-8;
+  so.unload.tolerance = 1e-8;
+  auto estimate = [&](const RegistrationModel& m) { return estimate_stiffness(m, g, s.landmark_anchors, s.landmark_supine, so); };
+  const StiffnessEstimate est = estimate(model);
+  ASSERT_FALSE(est.at_bound) << est.stop_reason;
+  RegistrationModel at_estimate = model;
+  scale_stiffness(at_estimate, est.scale);
+  set_rest_shape(at_estimate, est.rest, unload_report(est.unload, model.prone), g);
+  const double linear = log_youngs_modulus_per_compliance(at_estimate, {s.landmark_anchors, est.supine_prediction});
+  const double q0 = volume_compliance(model.material.poisson_ratio), h = 0.2 * q0;
+  auto log_e_at = [&](double q) {
+    RegistrationModel m = model;
+    set_poisson_ratio(m, 1.0 / (2.0 * (1.0 + q)));
+    const StiffnessEstimate e = estimate(m);
+    EXPECT_FALSE(e.at_bound) << e.stop_reason;
+    return std::log(e.youngs_modulus);
+  };
+  const double fd = (log_e_at(q0 + h) - log_e_at(q0 - h)) / (2 * h);
+  std::printf("E estimated at %.0f Pa (nu %.3f); d ln E / d q linear %.3f, re-estimated %.3f\n", est.youngs_modulus,
+              model.material.poisson_ratio, linear, fd);
+  EXPECT_GT(std::abs(fd), 0.5);  // the estimate does move with nu: else this test sees nothing
+  EXPECT_NEAR(linear, fd, 0.1 * std::abs(fd));
+  expect_throw_with<InputError>([&] { log_youngs_modulus_per_compliance(at_estimate, {{}, est.supine_prediction}); }, "3 landmarks");
+}
+
 // Where ICP on the rigid regions sets the pose, its fit's covariance is a source of the linear
 // region (and with uncertainty.rigid_pose false it is held); the report states the fit's sd.
 TEST(Uncertainty, TheRigidPoseIsASourceWhereIcpSetsIt) {

@@ -138,6 +138,9 @@ struct RegistrationResult {
   /// The sd of ln E about the estimate, from the landmarks' sd (the uncertainty sources') and
   /// how the misfit moves with E (StiffnessEstimate::log_sd); 0: not known or not estimated
   double estimated_youngs_modulus_log_sd = 0;
+  /// The stiffness step's supine gravity-only prediction at the estimate (model frame [m];
+  /// empty: not estimated): StiffnessEstimate::supine_prediction
+  Points stiffness_prediction;
   std::vector<StepReport> reports;
   Points x;                 ///< deformed vertex positions, model frame
   double seconds = 0;       ///< all steps, rigid alignment included

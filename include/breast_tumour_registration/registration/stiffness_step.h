@@ -58,6 +58,10 @@ struct StiffnessEstimate {
   /// the range, or no neighbour was simulated.
   double log_sd(double landmark_sd) const;
   Points rest;                ///< the unloaded shape at the estimate
+  /// The supine gravity-only equilibrium at the estimate (its candidate's, model frame [m]):
+  /// the prediction whose landmarks were fitted. The linear region differentiates it to see how
+  /// the estimate follows a Poisson's ratio other than the method's (tumour_uncertainty.h).
+  Points supine_prediction;
   UnloadResult unload;        ///< its unload
   double seconds = 0;
 };

@@ -35,7 +35,10 @@
 // depends on the inputs too, through the landmark step and the approach to the scan; with free
 // sliding the skin creeps along the scan and where the step stops sets its tangential position
 // (on the 4 mm phantom the re-solved response to a gravity tilt was 2.5x the fixed point's). The
-// coverage is not calibrated.
+// coverage is not calibrated. With E estimated, Poisson's ratio dominates the region, and the
+// tangent in q overstates it: whole re-registrations at nu 0.485 to 0.45 moved the tumours by
+// 0.4 to 0.9 of what it predicts (sub-linear in q, more so on stiffer bodies), so the region is
+// over-wide there (BENCHMARKS.md, "The linear region with Poisson's ratio").
 #pragma once
 
 #include <array>
@@ -44,6 +47,7 @@
 #include <utility>
 #include <vector>
 
+#include "breast_tumour_registration/geometry/anchor.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/geometry/surface_projector.h"
 #include "breast_tumour_registration/io/uncertainty_sources.h"
@@ -99,6 +103,10 @@ struct UncertaintyResult {
   bool rest_shape_follows = false;
   int rest_response_iterations = 0;
   double rest_response_seconds = 0;
+  /// With a LandmarkStiffnessFit: d ln E / d q, how the estimate follows the volume compliance
+  /// (0: not followed, E taken independent of nu).
+  bool estimate_follows_poisson_ratio = false;
+  double log_youngs_modulus_per_compliance = 0;
 };
 
 /// The volume compliance q = mu / lambda_L = (1 - 2 nu) / (2 nu) of Poisson's ratio nu: the
@@ -108,6 +116,22 @@ double volume_compliance(double nu);
 /// sqrt(E[(q(nu) - q(nominal_nu))^2]) for nu uniform over `range` (0 when the range is {0, 0}:
 /// held): the spread of the true compliance about the method's.
 double volume_compliance_rms(const std::array<double, 2>& range, double nominal_nu);
+
+/// Where the stiffness step estimated E from the landmarks: the landmarks and the supine
+/// gravity-only prediction they were fitted on (StiffnessEstimate::supine_prediction). With it
+/// the linearisation lets the estimate follow Poisson's ratio: a true nu other than the method's
+/// moves the predicted landmarks, and the estimate moves E to fit them again,
+/// d ln E / d q = -(dr/d ln E . dr/dq) / |dr/d ln E|^2 with r the landmarks' residual after
+/// their best rigid fit; the tumour's response to q is then dc/dq + dc/d ln E d ln E / d q.
+struct LandmarkStiffnessFit {
+  std::vector<Anchor> anchors;
+  Points supine_prediction;  ///< model frame [m]
+};
+
+/// d ln E / d q of the landmark fit at `model` (its E the estimate; its rest shape unloaded, as
+/// model.unloaded_under says, or the prone one): what the linearisation takes. InputError for
+/// fewer than 3 landmarks or a prediction that does not match the mesh.
+double log_youngs_modulus_per_compliance(const RegistrationModel& model, const LandmarkStiffnessFit& fit);
 
 /// A skin vertex held on the supine surface: its target point and unit normal (model frame).
 struct HeldSkinVertex {
@@ -121,7 +145,8 @@ struct HeldSkinVertex {
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
                                                 const SurfaceStepOptions& surface, const UncertaintyOptions& opt,
-                                                const std::optional<Mat6>& pose_covariance = std::nullopt);
+                                                const std::optional<Mat6>& pose_covariance = std::nullopt,
+                                                const LandmarkStiffnessFit* stiffness_fit = nullptr);
 
 /// x: the surface step's equilibrium (model frame); supine: the projector it ended on, which
 /// sees the model through model_to_projector; model_to_supine maps the result into the supine
@@ -132,7 +157,8 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
                                                 const UncertaintyOptions& opt,
-                                                const std::optional<Mat6>& pose_covariance = std::nullopt);
+                                                const std::optional<Mat6>& pose_covariance = std::nullopt,
+                                                const LandmarkStiffnessFit* stiffness_fit = nullptr);
 
 /// The spread of the registered tumour centroids over whole re-registrations with sampled
 /// inputs (RegistrationEngine::sample_uncertainty): the reference the linearisation is judged by,
