@@ -14,8 +14,9 @@
 // every tissue together (ln E about the nominal, with the sd of the log-uniform range, or, where
 // the stiffness step estimated E, the sd the landmarks leave: StiffnessEstimate::log_sd),
 // Poisson's ratio of every tissue together (linearised in the volume compliance
-// q = (1 - 2 nu) / (2 nu), in which the response is near linear, with q's root mean square
-// about the nominal over the uniform range: the range need not be centred on the nominal), the
+// q = (1 - 2 nu) / (2 nu), nearer linear than nu itself near 0.5 though still sub-linear (see
+// below), with q's root mean square about the nominal over the uniform range: the range need
+// not be centred on the nominal), the
 // direction of gravity (a tilt about the two horizontal axes), and the supine surface's depth
 // noise (along its normal, per held skin vertex), and the rigid pose when the fit that set it
 // says how well it did (ICP on the rigid regions: IcpResult::pose_covariance; the supine data
@@ -25,8 +26,9 @@
 // effect joins dG/dp. Not covered by the linearisation: the landmarks' localisation (except
 // through an estimated E's sd) and the landmark step's influence on where the surface step ends
 // (it is a start, not an input, of the equilibrium), a pose solved with the landmarks or the skin
-// (held at its solution), E's estimate compensating a wrong Poisson's ratio (the two are taken
-// as independent), and model error beyond these inputs. Sampling (RegistrationEngine::
+// (held at its solution), E's estimate compensating a wrong Poisson's ratio unless the
+// landmark fit it came from is given (LandmarkStiffnessFit; the pipeline gives it), and model
+// error beyond these inputs. Sampling (RegistrationEngine::
 // sample_uncertainty) draws every source, the landmarks included.
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
