@@ -39,7 +39,7 @@
 // (on the 4 mm phantom the re-solved response to a gravity tilt was 2.5x the fixed point's). The
 // coverage is not calibrated. With E estimated, Poisson's ratio dominates the region, and the
 // tangent in q overstates it: whole re-registrations at nu 0.485 to 0.45 moved the tumours by
-// 0.4 to 0.9 of what it predicts (sub-linear in q, more so on stiffer bodies), so the region is
+// 0.3 to 1.0 of what it predicts (sub-linear in q, more so on stiffer bodies), so the region is
 // over-wide there (BENCHMARKS.md, "The linear region with Poisson's ratio").
 #pragma once
 
