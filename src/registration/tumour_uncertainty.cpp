@@ -48,6 +48,23 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
   return p;
 }
 
+using Llt = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
+
+/// Factorizes the Hessian of `energy` at x into llt: the exact one, or, when it is not positive
+/// definite there, the projected one (returns true then). Throws SolverError naming `what` when
+/// neither factorizes.
+bool factorize_exact_or_projected(const TotalEnergy& energy, const Points& x, HessianAssembler& H, Llt& llt,
+                                  const std::string& what) {
+  llt.cholmod().print = 0;
+  energy.hessian(x, false, H);
+  llt.compute(H.matrix());
+  if (llt.info() == Eigen::Success) return false;
+  energy.hessian(x, true, H);
+  llt.compute(H.matrix());
+  if (llt.info() != Eigen::Success) throw SolverError("uncertainty: " + what + " cannot be factorized");
+  return true;
+}
+
 /// The model's materials with every tissue's Poisson's ratio set to `nu`, each keeping its
 /// Young's modulus (as set_poisson_ratio does).
 std::vector<StableNeoHookean> materials_at(const RegistrationModel& m, double nu) {
@@ -83,7 +100,7 @@ Eigen::VectorXd gradient_d_rest(const RegistrationModel& m, const Points& x, con
   const double largest = dX.cwiseAbs().maxCoeff();
   if (!(largest > 0)) return Eigen::VectorXd::Zero(dX.size());
   const double eps = 1e-6 / largest;
-  const Points D = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(dX.data(), dX.size() / 3, 3);
+  const auto D = as_points(dX);
   return (body_gradient(m, m.rest.V + eps * D, m.materials, x, gravity) -
           body_gradient(m, m.rest.V - eps * D, m.materials, x, gravity)) /
          (2 * eps);
@@ -106,15 +123,8 @@ RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& 
                                  const std::vector<Eigen::VectorXd>& dGp_dp) {
   const int nv = static_cast<int>(m.rest.V.rows());
   HessianAssembler Hp(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  llt.cholmod().print = 0;
-  elastic.hessian(m.prone, false, Hp);
-  llt.compute(Hp.matrix());
-  if (llt.info() != Eigen::Success) {  // only the preconditioner: the projected one serves too
-    elastic.hessian(m.prone, true, Hp);
-    llt.compute(Hp.matrix());
-    if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the prone Hessian cannot be factorized");
-  }
+  Llt llt;  // only the preconditioner: the projected one serves too
+  factorize_exact_or_projected(elastic, m.prone, Hp, llt, "the prone Hessian");
   auto scatter = [&](const Eigen::VectorXd& reduced) {
     Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
     Hp.scatter_add(reduced, 1.0, full);
@@ -136,6 +146,14 @@ RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& 
   return out;
 }
 
+/// The unloaded rest shape's response to ln E and (with_q) to q: the prone gradient's partials
+/// at the imaged shape (dG_p/d ln E = G_elastic there), the q column zero without q.
+RestResponse rest_response_to_material(const RegistrationModel& m, const TotalEnergy& elastic, bool with_q) {
+  return rest_shape_response(m, elastic,
+                             {elastic.gradient(m.prone), with_q ? elastic_gradient_d_compliance(m, m.prone)
+                                                                : Eigen::VectorXd::Zero(3 * m.rest.V.rows())});
+}
+
 bool fit_usable(const LandmarkStiffnessFit& fit, int nv) {
   return fit.anchors.size() >= 3 && fit.supine_prediction.rows() == nv && fit.supine_prediction.allFinite();
 }
@@ -150,21 +168,14 @@ double per_compliance(const RegistrationModel& m, const TotalEnergy& elastic, co
   const int nv = static_cast<int>(m.rest.V.rows());
   const Points& xg = fit.supine_prediction;
   HessianAssembler Hg(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  llt.cholmod().print = 0;
-  elastic.hessian(xg, false, Hg);
-  llt.compute(Hg.matrix());
-  if (llt.info() != Eigen::Success) {
-    elastic.hessian(xg, true, Hg);
-    llt.compute(Hg.matrix());
-    if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the stiffness prediction's Hessian cannot be factorized");
-  }
+  Llt llt;
+  factorize_exact_or_projected(elastic, xg, Hg, llt, "the stiffness prediction's Hessian");
   const int n = static_cast<int>(fit.anchors.size());
   auto landmark_motion = [&](Eigen::VectorXd partial, int input) {
     if (!dX_rest.empty()) partial += gradient_d_rest(m, xg, dX_rest[input], m.gravity);
     Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
     Hg.scatter_add(llt.solve(Hg.gather(partial)), -1.0, full);
-    const Points d = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(full.data(), nv, 3);
+    const Points d = as_points(full);
     Eigen::VectorXd l(3 * n);
     for (int i = 0; i < n; ++i) l.segment<3>(3 * i) = fit.anchors[i].position(d);
     return l;
@@ -212,7 +223,7 @@ double log_youngs_modulus_per_compliance(const RegistrationModel& model, const L
   add_model_elastic_energy(elastic, model);
   std::vector<Eigen::VectorXd> dX_rest;
   if (model.unloaded_under.norm() > 0)
-    dX_rest = rest_shape_response(model, elastic, {elastic.gradient(model.prone), elastic_gradient_d_compliance(model, model.prone)}).dX;
+    dX_rest = rest_response_to_material(model, elastic, true).dX;
   return per_compliance(model, elastic, fit, dX_rest);
 }
 
@@ -300,18 +311,11 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   jac.add(springs);
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
   use_single_threaded_blas();
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
-  llt.cholmod().print = 0;
-  jac.hessian(x, false, H);
-  llt.compute(H.matrix());
-  if (llt.info() != Eigen::Success) {
-    // An element compressed past its stable range makes the exact Hessian indefinite there;
-    // the projected one is a bound on the stiffness, so the spread it gives is a lower bound.
+  Llt llt;
+  // An element compressed past its stable range makes the exact Hessian indefinite there; the
+  // projected one is a bound on the stiffness, so the spread it gives is a lower bound.
+  if (factorize_exact_or_projected(jac, x, H, llt, "the fixed point's Jacobian"))
     out.note = "the exact Hessian is not positive definite at the result; linearised on the projected one (a lower bound)";
-    jac.hessian(x, true, H);
-    llt.compute(H.matrix());
-    if (llt.info() != Eigen::Success) throw SolverError("uncertainty: the fixed point's Jacobian cannot be factorized");
-  }
 
   // Inputs' dG/dp on the free DOFs. G_elastic is linear in E: dG/d ln E = G_elastic. Poisson's
   // ratio enters through the volume compliance q = (1 - 2 nu) / (2 nu), in which the response
@@ -328,8 +332,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   std::vector<Eigen::VectorXd> dX_rest;  // per input (ln E, q); empty: the rest shape is the prone one
   if (model.unloaded_under.norm() > 0 && (sd_log_e > 0 || sd_q > 0)) {
     const auto t_rest = std::chrono::steady_clock::now();
-    const RestResponse rr = rest_shape_response(
-        model, elastic, {elastic.gradient(model.prone), sd_q > 0 ? elastic_gradient_d_compliance(model, model.prone) : Eigen::VectorXd::Zero(3 * nv)});
+    const RestResponse rr = rest_response_to_material(model, elastic, sd_q > 0);
     dX_rest = rr.dX;
     const Vec3 g_s = gravity ? model.gravity : Vec3::Zero();
     full_E += gradient_d_rest(model, x, rr.dX[0], g_s);
