@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -89,11 +90,26 @@ void HessianAssembler::scatter_add(const Eigen::VectorXd& reduced, double scale,
 void TetScatter::build(const HessianAssembler& H, const Tetrahedra& T) {
   offsets_.assign(16 * T.rows(), -1);
   strides_.assign(4 * T.rows(), 0);
-  for (Eigen::Index t = 0; t < T.rows(); ++t)
-    for (int b = 0; b < 4; ++b) {
-      if (!H.is_fixed(T(t, b))) strides_[4 * t + b] = H.column_stride(T(t, b));
-      for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T(t, a), T(t, b));
+  // In parallel (an energy whose material changes is rebuilt with its maps: 46 times in one
+  // nodal-form registration with E estimated). block_offset throws for a pair outside the
+  // pattern; an exception must not leave an OpenMP region, so the first is kept and rethrown.
+  std::exception_ptr failed;
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index t = 0; t < T.rows(); ++t) {
+    try {
+      for (int b = 0; b < 4; ++b) {
+        if (!H.is_fixed(T(t, b))) strides_[4 * t + b] = H.column_stride(T(t, b));
+        for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T(t, a), T(t, b));
+      }
+    } catch (...) {
+#pragma omp critical(btr_tet_scatter)
+      if (!failed) failed = std::current_exception();
     }
+  }
+  if (failed) {
+    id_ = 0;
+    std::rethrow_exception(failed);
+  }
   id_ = H.id();
 }
 

@@ -1,9 +1,11 @@
 #include "breast_tumour_registration/fem/nodal_volume_energy.h"
 
 #include <algorithm>
+#include <exception>
 #include <string>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/determinant_eigensystem.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/small_matrices.h"
 
@@ -36,6 +38,15 @@ NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<doub
     std::sort(p.begin(), p.end());
     p.erase(std::unique(p.begin(), p.end()), p.end());
   }
+  column_start_.assign(nv + 1, 0);
+  for (const auto& p : patches_)
+    for (int j : p) ++column_start_[j + 1];
+  for (Eigen::Index j = 0; j < nv; ++j) column_start_[j + 1] += column_start_[j];
+  column_patches_.resize(column_start_.back());
+  std::vector<size_t> next(column_start_.begin(), column_start_.end() - 1);
+  for (Eigen::Index n = 0; n < nv; ++n)
+    for (size_t jj = 0; jj < patches_[n].size(); ++jj)
+      column_patches_[next[patches_[n][jj]]++] = {static_cast<int>(n), static_cast<int>(jj)};
 }
 
 Eigen::VectorXd NodalVolumeEnergy::element_volumes(const Points& x) const {
@@ -90,13 +101,24 @@ void NodalVolumeEnergy::build_scatter(const HessianAssembler& H) const {
     patch_stride_[n + 1] = patch_stride_[n] + patches_[n].size();
   }
   patch_offsets_.assign(patch_offset_.back(), -1);
-  patch_strides_.assign(patch_stride_.back(), 0);
-  for (size_t n = 0; n < patches_.size(); ++n) {
+  const Eigen::Index nv = static_cast<Eigen::Index>(patches_.size());
+  // block_offset throws for a pair outside the pattern (an assembler built without this term's
+  // cliques); an exception must not leave an OpenMP region, so the first is kept and rethrown.
+  std::exception_ptr failed;
+#pragma omp parallel for schedule(dynamic, 64)
+  for (Eigen::Index n = 0; n < nv; ++n) {
     const auto& p = patches_[n];
-    for (size_t j = 0; j < p.size(); ++j) {
-      if (!H.is_fixed(p[j])) patch_strides_[patch_stride_[n] + j] = H.column_stride(p[j]);
-      for (size_t i = 0; i < p.size(); ++i) patch_offsets_[patch_offset_[n] + j * p.size() + i] = H.block_offset(p[i], p[j]);
+    try {
+      for (size_t j = 0; j < p.size(); ++j)
+        for (size_t i = 0; i < p.size(); ++i) patch_offsets_[patch_offset_[n] + j * p.size() + i] = H.block_offset(p[i], p[j]);
+    } catch (...) {
+#pragma omp critical(btr_nodal_scatter)
+      if (!failed) failed = std::current_exception();
     }
+  }
+  if (failed) {
+    tet_scatter_ = TetScatter();  // not current for H
+    std::rethrow_exception(failed);
   }
 }
 
@@ -105,39 +127,52 @@ void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAs
   const Eigen::VectorXd J = nodal_volume_ratios(x);
   const Eigen::Index nt = T_.rows();
   // dv_t/dx per tetrahedron (12-vectors), for the rank-one patch terms.
-  std::vector<Vec12> dv(nt);
-  std::vector<Mat12> Ke(nt);
+  dv_.resize(nt);
+  ke_.resize(nt);
+  std::vector<Vec12>& dv = dv_;
+  std::vector<Mat12>& Ke = ke_;
 #pragma omp parallel for schedule(static)
   for (Eigen::Index t = 0; t < nt; ++t) {
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
     dv[t] = tet_gradient_from_stress(Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
-    const Mat9 H9 = element_pressure(J, t) * determinant_hessian(F);
-    Ke[t] = tet_hessian_from_stress_hessian(project_psd ? clamp_to_psd(H9) : H9, rest_[t].Dm_inv, rest_[t].volume);
+    const double s = element_pressure(J, t);
+    const Mat9 H9 = project_psd ? projected_determinant_hessian(F, s) : Mat9(s * determinant_hessian(F));
+    Ke[t] = tet_hessian_from_stress_hessian(H9, rest_[t].Dm_inv, rest_[t].volume);
   }
   for (Eigen::Index t = 0; t < nt; ++t) tet_scatter_.add(H, t, Ke[t]);
   double* values = H.values();
-  // sum_n lambda_n / V_n a_n a_n^T, a_n = sum_{t at n} dv_t/dx / 4 over the patch of n.
-  std::vector<Vec3> a;
-  for (size_t n = 0; n < patches_.size(); ++n) {
-    if (!(Vn_[n] > 0) || lambda_n_[n] == 0) continue;
+  // sum_n lambda_n / V_n a_n a_n^T, a_n = sum_{t at n} dv_t/dx / 4 over the patch of n: first
+  // every a_n (per vertex, in parallel), then the blocks column by column (column_patches_).
+  const Eigen::Index nv = static_cast<Eigen::Index>(patches_.size());
+  std::vector<Vec3>& a = a_;
+  a.assign(patch_stride_.back(), Vec3::Zero());
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index n = 0; n < nv; ++n) {
     const auto& p = patches_[n];
-    a.assign(p.size(), Vec3::Zero());
+    Vec3* an = a.data() + patch_stride_[n];
     for (int t : tets_of_[n])
       for (int k = 0; k < 4; ++k) {
         const size_t i = std::lower_bound(p.begin(), p.end(), T_(t, k)) - p.begin();
-        a[i] += dv[t].segment<3>(3 * k) / 4;
+        an[i] += dv[t].segment<3>(3 * k) / 4;
       }
-    const double c = lambda_n_[n] / Vn_[n];
-    const long* offs = patch_offsets_.data() + patch_offset_[n];
-    const long* strides = patch_strides_.data() + patch_stride_[n];
-    for (size_t j = 0; j < p.size(); ++j) {
-      const Vec3 aj = c * a[j];
-      for (size_t i = 0; i < p.size(); ++i) {
-        const long off = offs[j * p.size() + i];
+  }
+#pragma omp parallel for schedule(dynamic, 32)
+  for (Eigen::Index j = 0; j < nv; ++j) {
+    if (H.is_fixed(static_cast<int>(j))) continue;
+    const long stride = H.column_stride(static_cast<int>(j));
+    for (size_t e = column_start_[j]; e < column_start_[j + 1]; ++e) {
+      const auto [n, jj] = column_patches_[e];
+      if (!(Vn_[n] > 0) || lambda_n_[n] == 0) continue;
+      const size_t np = patches_[n].size();
+      const Vec3* an = a.data() + patch_stride_[n];
+      const Vec3 aj = lambda_n_[n] / Vn_[n] * an[jj];
+      const long* offs = patch_offsets_.data() + patch_offset_[n] + jj * np;
+      for (size_t i = 0; i < np; ++i) {
+        const long off = offs[i];
         if (off < 0) continue;
         for (int k = 0; k < 3; ++k)
-          for (int r = 0; r < 3; ++r) values[off + k * strides[j] + r] += a[i][r] * aj[k];
+          for (int r = 0; r < 3; ++r) values[off + k * stride + r] += an[i][r] * aj[k];
       }
     }
   }

@@ -3,7 +3,9 @@
 #include <random>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/determinant_eigensystem.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
+#include "breast_tumour_registration/fem/small_matrices.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/fem/nodal_volume_energy.h"
@@ -143,6 +145,34 @@ TEST(NodalVolumeEnergy, EqualsTheElementFormUnderUniformDeformationAndProjectsTo
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(H.matrix()));
   EXPECT_GT(es.eigenvalues().minCoeff(), -1e-8 * es.eigenvalues().cwiseAbs().maxCoeff());
   EXPECT_GT(count_inverted(y, m.T), 0) << "the check should include inverted elements";
+}
+
+// The closed-form projection of s d2J/dF2 equals the numerical eigen-clamp it replaced, for
+// stretched, compressed, nearly degenerate and inverted F and either sign of s; it is PSD and
+// leaves a PSD matrix (s d2J/dF2 is never PSD unless zero, so that case is s = 0).
+TEST(DeterminantEigensystem, TheClosedFormProjectionEqualsTheNumericalEigenClamp) {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> n(0.0, 0.3);
+  std::vector<Mat3> Fs;
+  for (int k = 0; k < 40; ++k) Fs.push_back(Mat3::Identity() + n(rng) * Mat3::Random());
+  Mat3 inverted = Mat3::Identity();
+  inverted(2, 2) = -0.4;
+  Fs.push_back(inverted);
+  Fs.push_back(Vec3(1.0, 1.0, 1e-9).asDiagonal());          // nearly flat
+  Fs.push_back(Vec3(1.2, 1.2, 1.2).asDiagonal());           // repeated singular values
+  Fs.push_back(Mat3::Zero());
+  int inverted_seen = 0;
+  for (const Mat3& F : Fs) {
+    inverted_seen += F.determinant() < 0;
+    for (double s : {2.5e4, -3.0e3}) {
+      const Mat9 numeric = clamp_to_psd(s * determinant_hessian(F));
+      const Mat9 closed = projected_determinant_hessian(F, s);
+      EXPECT_LT((closed - numeric).norm(), 1e-9 * std::max(1.0, numeric.norm())) << "F =\n" << F << "\ns = " << s;
+      EXPECT_LT((closed - closed.transpose()).norm(), 1e-12 * std::max(1.0, closed.norm()));
+    }
+  }
+  EXPECT_GT(inverted_seen, 0);
+  EXPECT_EQ(projected_determinant_hessian(Fs[0], 0.0).norm(), 0.0);
 }
 
 TEST(GravityEnergy, GradientMatchesFiniteDifferencesAndMassIsConserved) {

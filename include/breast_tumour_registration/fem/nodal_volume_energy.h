@@ -18,6 +18,7 @@
 // eigen-clamped per element when projecting). The patches are its Hessian cliques.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "breast_tumour_registration/fem/energy_term.h"
@@ -52,12 +53,24 @@ class NodalVolumeEnergy : public EnergyTerm {
   std::vector<std::vector<int>> patches_;    // per vertex: sorted vertices of its tetrahedra (empty: none)
   std::vector<std::vector<int>> tets_of_;    // per vertex: its tetrahedra
   // Scatter maps into the assembler's values, built on first use per assembler: the element
-  // blocks, and for vertex n |patch|^2 block offsets (from patch_offset_[n]) and |patch| column
-  // strides (from patch_stride_[n]); -1: a fixed vertex.
+  // blocks, and for vertex n |patch|^2 block offsets (from patch_offset_[n]; -1: a fixed vertex);
+  // patch_stride_[n]: where vertex n's |patch| entries start in per-patch-vertex arrays.
   void build_scatter(const HessianAssembler& H) const;
   mutable TetScatter tet_scatter_;  // its assembler id also marks the patch maps as current
-  mutable std::vector<long> patch_offsets_, patch_strides_;
+  mutable std::vector<long> patch_offsets_;
   mutable std::vector<size_t> patch_offset_, patch_stride_;
+  // The patch terms are added column by column, in parallel: vertex j's blocks (i, j) live in
+  // its own three columns, so no two threads write one entry. Per vertex j (from column_start_[j]):
+  // the vertices n whose patch holds j, ascending (the order the entries were summed in before),
+  // and j's position in that patch.
+  std::vector<size_t> column_start_;
+  std::vector<std::pair<int, int>> column_patches_;
+  // Per-call work arrays kept between Hessians (per tetrahedron: dv_t/dx and its 12 x 12 block;
+  // per patch vertex: a_n), as ElasticEnergy keeps its blocks: 10 MB allocated and freed per
+  // Hessian on an 8k-tet mesh otherwise.
+  mutable std::vector<Vec12> dv_;
+  mutable std::vector<Mat12> ke_;
+  mutable std::vector<Vec3> a_;
 };
 
 }  // namespace btr

@@ -1,0 +1,20 @@
+// The Hessian of J = det F, d2J/dvec(F)2, projected to positive semi-definite in closed form.
+// In the frame of the rotation-variant SVD F = U diag(S) V^T its eigensystem is known
+// (Smith, de Goes & Kim 2019, "Analytic eigensystems for isotropic distortion energies"): per
+// pair (j, k) with third index i a twist U (e_j e_k^T - e_k e_j^T) V^T / sqrt 2 with eigenvalue
+// +S_i and a flip U (e_j e_k^T + e_k e_j^T) V^T / sqrt 2 with -S_i, and on the scaling modes
+// U diag(w) V^T the 3 x 3 block [[0, S_2, S_1], [S_2, 0, S_0], [S_1, S_0, 0]]. The nodal volume
+// term projects s d2J/dF2 for every tetrahedron at every Newton step; the numerical 9 x 9
+// eigen-solve it replaces took 23 of the 32 ms of its Hessian on SfePy's 8.3k-tet body
+// (bench/probes/nodal_assembly.cpp).
+#pragma once
+
+#include "breast_tumour_registration/base/types.h"
+
+namespace btr {
+
+/// scale * d2J/dvec(F)2 (vec column-major, as determinant_hessian) with its negative
+/// eigenvalues set to zero. Equal, to round-off, to clamp_to_psd(scale * determinant_hessian(F)).
+Mat9 projected_determinant_hessian(const Mat3& F, double scale);
+
+}  // namespace btr
