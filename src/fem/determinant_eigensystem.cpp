@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/fem/determinant_eigensystem.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "breast_tumour_registration/fem/small_matrices.h"
@@ -8,14 +9,16 @@
 
 namespace btr {
 
-Mat9 projected_determinant_hessian(const Mat3& F, double scale) {
+Mat9 projected_determinant_hessian(const Mat3& F, double scale, double shift) {
   Mat9 H = Mat9::Zero();
-  if (scale == 0) return H;
+  if (scale == 0) return Mat9::Identity() * std::max(shift, 0.0);
   Mat3 U, V;
   Vec3 S;
   rotation_variant_svd(F, U, S, V);
-  // The sum of the positive eigenpairs: at most five of the nine (the scaling block has trace 0).
+  // The sum of the positive eigenpairs (without a shift at most five of the nine: the scaling
+  // block has trace 0).
   auto add = [&](double lambda, const Mat3& D) {
+    lambda += shift;
     if (!(lambda > 0)) return;
     const Mat3 Q = U * D * V.transpose();
     const Eigen::Map<const Vec9> q(Q.data());

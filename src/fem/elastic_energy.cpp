@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/fem/elastic_energy.h"
 
 #include <string>
+#include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/nodal_volume_energy.h"
@@ -69,14 +70,21 @@ void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vec
     energy.add(std::make_shared<ElasticEnergy>(rest, materials, material_of));
     return;
   }
-  std::vector<StableNeoHookean> shear;
-  for (const auto& m : materials) shear.push_back(m.shear_part());
-  auto elastic = std::make_shared<ElasticEnergy>(rest, shear, material_of);
-  std::vector<double> lambda(rest.T.rows());
-  for (Eigen::Index t = 0; t < rest.T.rows(); ++t)
-    lambda[t] = materials[material_of.empty() ? 0 : material_of[t]].lambda();
-  energy.add(elastic);
-  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda));
+  // One term for the shear part and the volume term on nodal averages (nodal_volume_energy.h):
+  // one projected block per tetrahedron.
+  if (materials.empty()) throw InputError("add_elastic_energy: no material given");
+  if (!material_of.empty() && static_cast<Eigen::Index>(material_of.size()) != rest.T.rows())
+    throw InputError("add_elastic_energy: material_of has " + std::to_string(material_of.size()) + " entries for " +
+                     std::to_string(rest.T.rows()) + " tetrahedra");
+  std::vector<double> lambda(rest.T.rows()), mu(rest.T.rows());
+  for (Eigen::Index t = 0; t < rest.T.rows(); ++t) {
+    const int k = material_of.empty() ? 0 : material_of[t];
+    if (k < 0 || k >= static_cast<int>(materials.size()))
+      throw InputError("add_elastic_energy: material index " + std::to_string(k) + " out of range");
+    lambda[t] = materials[k].lambda();
+    mu[t] = materials[k].mu();
+  }
+  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda, std::move(mu)));
 }
 
 }  // namespace btr

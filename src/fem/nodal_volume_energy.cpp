@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <exception>
 #include <string>
+#include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/determinant_eigensystem.h"
@@ -11,11 +12,17 @@
 
 namespace btr {
 
-NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda)
-    : T_(rest.T), rest_(compute_rest_data(rest)) {
+NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<double> mu)
+    : T_(rest.T), rest_(compute_rest_data(rest)), mu_(std::move(mu)) {
   if (static_cast<Eigen::Index>(lambda.size()) != T_.rows())
     throw InputError("NodalVolumeEnergy: " + std::to_string(lambda.size()) + " volume stiffnesses for " +
                      std::to_string(T_.rows()) + " tetrahedra");
+  if (!mu_.empty() && static_cast<Eigen::Index>(mu_.size()) != T_.rows())
+    throw InputError("NodalVolumeEnergy: " + std::to_string(mu_.size()) + " shear moduli for " + std::to_string(T_.rows()) +
+                     " tetrahedra");
+  for (size_t t = 0; t < mu_.size(); ++t)
+    if (!(mu_[t] > 0) || !std::isfinite(mu_[t]))
+      throw InputError("NodalVolumeEnergy: shear modulus of tetrahedron " + std::to_string(t) + " is not > 0");
   const Eigen::Index nv = rest.V.rows();
   Vn_ = Eigen::VectorXd::Zero(nv);
   lambda_n_ = Eigen::VectorXd::Zero(nv);
@@ -77,19 +84,34 @@ double NodalVolumeEnergy::value(const Points& x) const {
   double e = 0;
   for (Eigen::Index n = 0; n < J.size(); ++n)
     if (Vn_[n] > 0) e += 0.5 * lambda_n_[n] * Vn_[n] * (J[n] - 1) * (J[n] - 1);
+  if (!mu_.empty()) {
+    double shear = 0;
+#pragma omp parallel for reduction(+ : shear) schedule(static)
+    for (Eigen::Index t = 0; t < T_.rows(); ++t) {
+      const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
+      shear += rest_[t].volume * mu_[t] * (0.5 * (F.squaredNorm() - 3) - (F.determinant() - 1));
+    }
+    e += shear;
+  }
   return e;
 }
 
 void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const {
   // dE/dx = sum_t s_t dv_t/dx, s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4.
+  // With the shear part: + V_t (mu F - mu cof F) per element.
   const Eigen::VectorXd J = nodal_volume_ratios(x);
-  for (Eigen::Index t = 0; t < T_.rows(); ++t) {
-    const double s = element_pressure(J, t);
+  const Eigen::Index nt = T_.rows();
+  grad_.resize(nt);
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index t = 0; t < nt; ++t) {
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
-    const Vec12 gt = tet_gradient_from_stress(s * Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
-    for (int a = 0; a < 4; ++a) g.segment<3>(3 * T_(t, a)) += gt.segment<3>(3 * a);
+    Mat3 P = element_pressure(J, t) * Eigen::Map<const Mat3>(dJ.data());
+    if (!mu_.empty()) P += mu_[t] * (F - Eigen::Map<const Mat3>(dJ.data()));
+    grad_[t] = tet_gradient_from_stress(P, rest_[t].Dm_inv, rest_[t].volume);
   }
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int a = 0; a < 4; ++a) g.segment<3>(3 * T_(t, a)) += grad_[t].segment<3>(3 * a);
 }
 
 void NodalVolumeEnergy::build_scatter(const HessianAssembler& H) const {
@@ -136,8 +158,10 @@ void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAs
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
     dv[t] = tet_gradient_from_stress(Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
-    const double s = element_pressure(J, t);
-    const Mat9 H9 = project_psd ? projected_determinant_hessian(F, s) : Mat9(s * determinant_hessian(F));
+    // s d2J/dF2, or with the shear part mu I + (s - mu) d2J/dF2.
+    const double mu = mu_.empty() ? 0.0 : mu_[t], c = element_pressure(J, t) - mu;
+    const Mat9 H9 = project_psd ? projected_determinant_hessian(F, c, mu)
+                                : Mat9(c * determinant_hessian(F) + mu * Mat9::Identity());
     Ke[t] = tet_hessian_from_stress_hessian(H9, rest_[t].Dm_inv, rest_[t].volume);
   }
   for (Eigen::Index t = 0; t < nt; ++t) tet_scatter_.add(H, t, Ke[t]);

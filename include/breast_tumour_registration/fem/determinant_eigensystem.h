@@ -13,8 +13,11 @@
 
 namespace btr {
 
-/// scale * d2J/dvec(F)2 (vec column-major, as determinant_hessian) with its negative
-/// eigenvalues set to zero. Equal, to round-off, to clamp_to_psd(scale * determinant_hessian(F)).
-Mat9 projected_determinant_hessian(const Mat3& F, double scale);
+/// shift * I + scale * d2J/dvec(F)2 (vec column-major, as determinant_hessian) with its
+/// negative eigenvalues set to zero (I shares every eigenvector: the eigenvalues are shifted).
+/// Equal, to round-off, to clamp_to_psd(shift * I + scale * determinant_hessian(F)). With
+/// shift = mu and scale = p - mu it is the projected Hessian of the shear part of the stable
+/// Neo-Hookean energy, mu/2 (I_C - 3) - mu (J - 1), plus a pressure p (J - 1).
+Mat9 projected_determinant_hessian(const Mat3& F, double scale, double shift = 0);
 
 }  // namespace btr

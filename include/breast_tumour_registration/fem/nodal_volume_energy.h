@@ -3,7 +3,8 @@
 // linear tetrahedra do not lock as nu -> 0.5. With the element form every tetrahedron must
 // keep its own volume: about 5 constraints per vertex against 3 degrees of freedom, and a
 // near-incompressible mesh cannot bend. Averaged over each vertex's patch there is one per
-// vertex. Together with ElasticEnergy on the materials' shear parts (shear_part()):
+// vertex. Together with the shear part (in this term given the shear moduli, as
+// add_elastic_energy builds it, or as ElasticEnergy on the materials' shear_part()):
 //
 //   E = sum_t V_t [mu/2 (I_C - 3) - mu (J_t - 1)] + sum_n V_n lambda_n / 2 (Jbar_n - 1)^2,
 //   V_n = sum_{t at n} V_t / 4,   Jbar_n = sum_{t at n} V_t J_t / (4 V_n),
@@ -16,6 +17,11 @@
 // Hessian: sum_n lambda_n / V_n a_n a_n^T (a_n = dv_n/dx, PSD, couples a vertex's whole patch)
 // plus sum_t s_t d2v_t/dx2 with s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 (indefinite;
 // eigen-clamped per element when projecting). The patches are its Hessian cliques.
+//
+// Given the shear moduli, the term carries the shear part too (add_elastic_energy does so): per
+// element its Hessian is then V_t (mu I + (s_t - mu) d2J/dF2), projected as one matrix in closed
+// form (determinant_eigensystem.h), one 12 x 12 block per tetrahedron instead of two, and a
+// projection of the sum rather than of each part (which clamps more than it needs to).
 #pragma once
 
 #include <utility>
@@ -30,9 +36,11 @@ class NodalVolumeEnergy : public EnergyTerm {
  public:
   /// rest    rest configuration
   /// lambda  #T volume stiffness per tetrahedron [Pa] (StableNeoHookean::lambda(), >= 0)
-  NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda);
+  /// mu      #T shear modulus per tetrahedron [Pa] (> 0): the shear part of the stable
+  ///         Neo-Hookean energy, mu/2 (I_C - 3) - mu (J - 1), is part of this term; empty: not
+  NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<double> mu = {});
 
-  std::string name() const override { return "nodal volume"; }
+  std::string name() const override { return mu_.empty() ? "nodal volume" : "elastic (nodal volume)"; }
   double value(const Points& x) const override;
   void add_gradient(const Points& x, Eigen::VectorXd& g) const override;
   void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const override;
@@ -48,6 +56,7 @@ class NodalVolumeEnergy : public EnergyTerm {
   Eigen::VectorXd element_volumes(const Points& x) const;
   Tetrahedra T_;
   std::vector<TetRestData> rest_;
+  std::vector<double> mu_;   // per tetrahedron, or empty (no shear part)
   Eigen::VectorXd Vn_;       // rest patch volume / 4 per vertex (V_n)
   Eigen::VectorXd lambda_n_;
   std::vector<std::vector<int>> patches_;    // per vertex: sorted vertices of its tetrahedra (empty: none)
@@ -65,10 +74,10 @@ class NodalVolumeEnergy : public EnergyTerm {
   // and j's position in that patch.
   std::vector<size_t> column_start_;
   std::vector<std::pair<int, int>> column_patches_;
-  // Per-call work arrays kept between Hessians (per tetrahedron: dv_t/dx and its 12 x 12 block;
+  // Per-call work arrays kept between calls (per tetrahedron: its gradient, dv_t/dx and its 12 x 12 block;
   // per patch vertex: a_n), as ElasticEnergy keeps its blocks: 10 MB allocated and freed per
   // Hessian on an 8k-tet mesh otherwise.
-  mutable std::vector<Vec12> dv_;
+  mutable std::vector<Vec12> grad_, dv_;
   mutable std::vector<Mat12> ke_;
   mutable std::vector<Vec3> a_;
 };
