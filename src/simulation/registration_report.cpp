@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/volume_form.h"
 #include "breast_tumour_registration/geometry/confidence_ellipsoid.h"
 #include "breast_tumour_registration/geometry/margin_shell.h"
 #include "breast_tumour_registration/geometry/shapes.h"
@@ -134,6 +135,9 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                          {"tetrahedra", i < model.material_tetrahedra.size() ? model.material_tetrahedra[i] : 0}});
   }
   j["materials"] = materials;
+  // Which material model ran: the volume term's form (resolved from the scene's `auto`) and
+  // Poisson's ratio, which set how far the same E lets the tissue sag.
+  j["material_model"] = {{"volume_form", to_string(model.volume_form)}, {"poisson_ratio", num(model.material.poisson_ratio)}};
   if (r.steps.stiffness) {
     Json evaluations = Json::array();
     for (const auto& [E, misfit] : r.stiffness_evaluations)

@@ -74,8 +74,11 @@ TEST(MaterialRegions, TheLabelledPhantomGivesEachTissueItsMaterial) {
   for (size_t t = 0; t < labels.size(); ++t) EXPECT_EQ(m.material_of[t], labels[t] - 1) << t;
   EXPECT_NEAR(youngs_modulus(m.materials[1]), 6800, 1e-6);
   const RegistrationResult r = run_registration(s, m, preset_options("balanced"));
-  const nlohmann::json materials = nlohmann::json::parse(registration_report_json(s, m, r, 0)).at("materials");
+  const nlohmann::json report = nlohmann::json::parse(registration_report_json(s, m, r, 0));
+  const nlohmann::json& materials = report.at("materials");
   ASSERT_EQ(materials.size(), 3u);
+  EXPECT_EQ(report.at("material_model").at("volume_form"), "element");  // auto at nu 0.49
+  EXPECT_NEAR(report.at("material_model").at("poisson_ratio").get<double>(), 0.49, 1e-12);
   EXPECT_EQ(materials[1].at("name"), "gland");
   EXPECT_NEAR(materials[1].at("youngs_modulus_Pa").get<double>(), 6800, 1e-6);
   EXPECT_EQ(materials[1].at("tetrahedra").get<long>(), gland);
