@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "breast_tumour_registration/fem/small_matrices.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
 
 namespace btr {

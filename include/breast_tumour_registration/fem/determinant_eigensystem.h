@@ -3,10 +3,10 @@
 // (Smith, de Goes & Kim 2019, "Analytic eigensystems for isotropic distortion energies"): per
 // pair (j, k) with third index i a twist U (e_j e_k^T - e_k e_j^T) V^T / sqrt 2 with eigenvalue
 // +S_i and a flip U (e_j e_k^T + e_k e_j^T) V^T / sqrt 2 with -S_i, and on the scaling modes
-// U diag(w) V^T the 3 x 3 block [[0, S_2, S_1], [S_2, 0, S_0], [S_1, S_0, 0]]. The nodal volume
-// term projects s d2J/dF2 for every tetrahedron at every Newton step; the numerical 9 x 9
-// eigen-solve it replaces took 23 of the 32 ms of its Hessian on SfePy's 8.3k-tet body
-// (bench/probes/nodal_assembly.cpp).
+// U diag(w) V^T the 3 x 3 block [[0, S_2, S_1], [S_2, 0, S_0], [S_1, S_0, 0]]. The nodal form
+// projects mu I + (s - mu) d2J/dF2 for every tetrahedron at every Newton step; the numerical
+// 9 x 9 eigen-solve this replaced took 23 of the 32 ms of its volume term's Hessian on SfePy's
+// 8.3k-tet body (bench/probes/nodal_assembly.cpp).
 #pragma once
 
 #include "breast_tumour_registration/base/types.h"

@@ -70,8 +70,8 @@ class NodalVolumeEnergy : public EnergyTerm {
   mutable std::vector<size_t> patch_offset_, patch_stride_;
   // The patch terms are added column by column, in parallel: vertex j's blocks (i, j) live in
   // its own three columns, so no two threads write one entry. Per vertex j (from column_start_[j]):
-  // the vertices n whose patch holds j, ascending (the order the entries were summed in before),
-  // and j's position in that patch.
+  // the vertices n whose patch holds j, ascending (so each entry sums its terms in the order of a
+  // serial loop over n, whatever the threads), and j's position in that patch.
   std::vector<size_t> column_start_;
   std::vector<std::pair<int, int>> column_patches_;
   // Per-call work arrays kept between calls (per tetrahedron: its gradient, dv_t/dx and its 12 x 12 block;
