@@ -46,13 +46,10 @@ int main(int argc, char** argv) {
 
   std::vector<StableNeoHookean> shear;
   for (const auto& mat : m.materials) shear.push_back(mat.shear_part());
-  std::vector<double> lambda(m.rest.T.rows()), mu(m.rest.T.rows());
-  for (Eigen::Index t = 0; t < m.rest.T.rows(); ++t) {
-    lambda[t] = m.materials[m.material_of[t]].lambda();
-    mu[t] = m.materials[m.material_of[t]].mu();
-  }
+  std::vector<double> lambda(m.rest.T.rows());
+  for (Eigen::Index t = 0; t < m.rest.T.rows(); ++t) lambda[t] = m.materials[m.material_of[t]].lambda();
   const ElasticEnergy element(m.rest, m.materials, m.material_of), shear_only(m.rest, shear, m.material_of);
-  const NodalVolumeEnergy nodal(m.rest, lambda), combined(m.rest, lambda, mu);
+  const NodalVolumeEnergy nodal(m.rest, lambda), combined(m.rest, lambda, shear, m.material_of);
 
   HessianAssembler He(nv, m.rest.T, m.fixed), Hn(nv, m.rest.T, m.fixed, nodal.hessian_cliques());
   const double t_el = median_seconds(repeats, [&] { He.set_zero(); element.add_hessian(x, true, He); });

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/material_assignment.h"
 #include "breast_tumour_registration/fem/nodal_volume_energy.h"
 
 namespace btr {
@@ -11,16 +12,7 @@ namespace btr {
 ElasticEnergy::ElasticEnergy(const TetMesh& rest, std::vector<StableNeoHookean> materials,
                              std::vector<int> material_of)
     : T_(rest.T), rest_(compute_rest_data(rest)), materials_(std::move(materials)),
-      material_of_(std::move(material_of)) {
-  if (materials_.empty()) throw InputError("ElasticEnergy: no material given");
-  if (material_of_.empty()) material_of_.assign(T_.rows(), 0);
-  if (static_cast<Eigen::Index>(material_of_.size()) != T_.rows())
-    throw InputError("ElasticEnergy: material_of has " + std::to_string(material_of_.size()) + " entries for " +
-                     std::to_string(T_.rows()) + " tetrahedra");
-  for (int m : material_of_)
-    if (m < 0 || m >= static_cast<int>(materials_.size()))
-      throw InputError("ElasticEnergy: material index " + std::to_string(m) + " out of range");
-}
+      material_of_(checked_material_of(std::move(material_of), materials_.size(), T_.rows(), "ElasticEnergy")) {}
 
 double ElasticEnergy::element_value(const Points& x, Eigen::Index t) const {
   const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
@@ -72,19 +64,12 @@ void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vec
   }
   // One term for the shear part and the volume term on nodal averages (nodal_volume_energy.h):
   // one projected block per tetrahedron.
-  if (materials.empty()) throw InputError("add_elastic_energy: no material given");
-  if (!material_of.empty() && static_cast<Eigen::Index>(material_of.size()) != rest.T.rows())
-    throw InputError("add_elastic_energy: material_of has " + std::to_string(material_of.size()) + " entries for " +
-                     std::to_string(rest.T.rows()) + " tetrahedra");
-  std::vector<double> lambda(rest.T.rows()), mu(rest.T.rows());
-  for (Eigen::Index t = 0; t < rest.T.rows(); ++t) {
-    const int k = material_of.empty() ? 0 : material_of[t];
-    if (k < 0 || k >= static_cast<int>(materials.size()))
-      throw InputError("add_elastic_energy: material index " + std::to_string(k) + " out of range");
-    lambda[t] = materials[k].lambda();
-    mu[t] = materials[k].mu();
-  }
-  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda, std::move(mu)));
+  std::vector<int> of = checked_material_of(material_of, materials.size(), rest.T.rows(), "add_elastic_energy");
+  std::vector<StableNeoHookean> shear;
+  for (const auto& m : materials) shear.push_back(m.shear_part());
+  std::vector<double> lambda(rest.T.rows());
+  for (Eigen::Index t = 0; t < rest.T.rows(); ++t) lambda[t] = materials[of[t]].lambda();
+  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda, std::move(shear), std::move(of)));
 }
 
 }  // namespace btr

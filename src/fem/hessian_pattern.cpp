@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "breast_tumour_registration/base/parallel_for.h"
+
 namespace btr {
 
 HessianAssembler::HessianAssembler(int nv, const Tetrahedra& T, const std::vector<bool>& fixed,
@@ -91,22 +93,13 @@ void TetScatter::build(const HessianAssembler& H, const Tetrahedra& T) {
   offsets_.assign(16 * T.rows(), -1);
   strides_.assign(4 * T.rows(), 0);
   // In parallel (an energy whose material changes is rebuilt with its maps: 46 times in one
-  // nodal-form registration with E estimated). block_offset throws for a pair outside the
-  // pattern; an exception must not leave an OpenMP region, so the first is kept and rethrown.
-  std::exception_ptr failed;
-#pragma omp parallel for schedule(static)
-  for (Eigen::Index t = 0; t < T.rows(); ++t) {
-    try {
-      for (int b = 0; b < 4; ++b) {
-        if (!H.is_fixed(T(t, b))) strides_[4 * t + b] = H.column_stride(T(t, b));
-        for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T(t, a), T(t, b));
-      }
-    } catch (...) {
-#pragma omp critical(btr_tet_scatter)
-      if (!failed) failed = std::current_exception();
-    }
-  }
-  if (failed) {
+  // nodal-form registration with E estimated); block_offset throws for a pair outside the pattern.
+  if (const std::exception_ptr failed = parallel_for_capturing(T.rows(), [&](Eigen::Index t) {
+        for (int b = 0; b < 4; ++b) {
+          if (!H.is_fixed(T(t, b))) strides_[4 * t + b] = H.column_stride(T(t, b));
+          for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T(t, a), T(t, b));
+        }
+      })) {
     id_ = 0;
     std::rethrow_exception(failed);
   }

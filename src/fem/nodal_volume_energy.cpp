@@ -6,23 +6,25 @@
 #include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/parallel_for.h"
 #include "breast_tumour_registration/fem/determinant_eigensystem.h"
+#include "breast_tumour_registration/fem/material_assignment.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/small_matrices.h"
 
 namespace btr {
 
-NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<double> mu)
-    : T_(rest.T), rest_(compute_rest_data(rest)), mu_(std::move(mu)) {
+NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda,
+                                     std::vector<StableNeoHookean> shear, std::vector<int> material_of)
+    : T_(rest.T), rest_(compute_rest_data(rest)), shear_(std::move(shear)), material_of_(std::move(material_of)) {
   if (static_cast<Eigen::Index>(lambda.size()) != T_.rows())
     throw InputError("NodalVolumeEnergy: " + std::to_string(lambda.size()) + " volume stiffnesses for " +
                      std::to_string(T_.rows()) + " tetrahedra");
-  if (!mu_.empty() && static_cast<Eigen::Index>(mu_.size()) != T_.rows())
-    throw InputError("NodalVolumeEnergy: " + std::to_string(mu_.size()) + " shear moduli for " + std::to_string(T_.rows()) +
-                     " tetrahedra");
-  for (size_t t = 0; t < mu_.size(); ++t)
-    if (!(mu_[t] > 0) || !std::isfinite(mu_[t]))
-      throw InputError("NodalVolumeEnergy: shear modulus of tetrahedron " + std::to_string(t) + " is not > 0");
+  for (size_t k = 0; k < shear_.size(); ++k)
+    if (shear_[k].lambda() != 0)
+      throw InputError("NodalVolumeEnergy: material " + std::to_string(k) +
+                       " has a volume term of its own (give its shear_part(): the volume term is this term's)");
+  if (!shear_.empty()) material_of_ = checked_material_of(std::move(material_of_), shear_.size(), T_.rows(), "NodalVolumeEnergy");
   const Eigen::Index nv = rest.V.rows();
   Vn_ = Eigen::VectorXd::Zero(nv);
   lambda_n_ = Eigen::VectorXd::Zero(nv);
@@ -84,13 +86,11 @@ double NodalVolumeEnergy::value(const Points& x) const {
   double e = 0;
   for (Eigen::Index n = 0; n < J.size(); ++n)
     if (Vn_[n] > 0) e += 0.5 * lambda_n_[n] * Vn_[n] * (J[n] - 1) * (J[n] - 1);
-  if (!mu_.empty()) {
+  if (!shear_.empty()) {
     double shear = 0;
 #pragma omp parallel for reduction(+ : shear) schedule(static)
-    for (Eigen::Index t = 0; t < T_.rows(); ++t) {
-      const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
-      shear += rest_[t].volume * mu_[t] * (0.5 * (F.squaredNorm() - 3) - (F.determinant() - 1));
-    }
+    for (Eigen::Index t = 0; t < T_.rows(); ++t)
+      shear += rest_[t].volume * shear_[material_of_[t]].psi(deformation_gradient(x, T_.row(t), rest_[t].Dm_inv));
     e += shear;
   }
   return e;
@@ -98,7 +98,7 @@ double NodalVolumeEnergy::value(const Points& x) const {
 
 void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const {
   // dE/dx = sum_t s_t dv_t/dx, s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4.
-  // With the shear part: + V_t (mu F - mu cof F) per element.
+  // With the shear part: + V_t P_shear(F) per element.
   const Eigen::VectorXd J = nodal_volume_ratios(x);
   const Eigen::Index nt = T_.rows();
   grad_.resize(nt);
@@ -107,7 +107,7 @@ void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const 
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
     Mat3 P = element_pressure(J, t) * Eigen::Map<const Mat3>(dJ.data());
-    if (!mu_.empty()) P += mu_[t] * (F - Eigen::Map<const Mat3>(dJ.data()));
+    if (!shear_.empty()) P += shear_[material_of_[t]].pk1(F);
     grad_[t] = tet_gradient_from_stress(P, rest_[t].Dm_inv, rest_[t].volume);
   }
   for (Eigen::Index t = 0; t < nt; ++t)
@@ -125,20 +125,12 @@ void NodalVolumeEnergy::build_scatter(const HessianAssembler& H) const {
   patch_offsets_.assign(patch_offset_.back(), -1);
   const Eigen::Index nv = static_cast<Eigen::Index>(patches_.size());
   // block_offset throws for a pair outside the pattern (an assembler built without this term's
-  // cliques); an exception must not leave an OpenMP region, so the first is kept and rethrown.
-  std::exception_ptr failed;
-#pragma omp parallel for schedule(dynamic, 64)
-  for (Eigen::Index n = 0; n < nv; ++n) {
-    const auto& p = patches_[n];
-    try {
-      for (size_t j = 0; j < p.size(); ++j)
-        for (size_t i = 0; i < p.size(); ++i) patch_offsets_[patch_offset_[n] + j * p.size() + i] = H.block_offset(p[i], p[j]);
-    } catch (...) {
-#pragma omp critical(btr_nodal_scatter)
-      if (!failed) failed = std::current_exception();
-    }
-  }
-  if (failed) {
+  // cliques).
+  if (const std::exception_ptr failed = parallel_for_capturing(nv, [&](Eigen::Index n) {
+        const auto& p = patches_[n];
+        for (size_t j = 0; j < p.size(); ++j)
+          for (size_t i = 0; i < p.size(); ++i) patch_offsets_[patch_offset_[n] + j * p.size() + i] = H.block_offset(p[i], p[j]);
+      })) {
     tet_scatter_ = TetScatter();  // not current for H
     std::rethrow_exception(failed);
   }
@@ -159,7 +151,7 @@ void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAs
     const Vec9 dJ = determinant_gradient(F);
     dv[t] = tet_gradient_from_stress(Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
     // s d2J/dF2, or with the shear part mu I + (s - mu) d2J/dF2.
-    const double mu = mu_.empty() ? 0.0 : mu_[t], c = element_pressure(J, t) - mu;
+    const double mu = shear_.empty() ? 0.0 : shear_[material_of_[t]].mu(), c = element_pressure(J, t) - mu;
     const Mat9 H9 = project_psd ? projected_determinant_hessian(F, c, mu)
                                 : Mat9(c * determinant_hessian(F) + mu * Mat9::Identity());
     Ke[t] = tet_hessian_from_stress_hessian(H9, rest_[t].Dm_inv, rest_[t].volume);

@@ -187,12 +187,10 @@ TEST(NodalVolumeEnergy, WithTheShearPartItEqualsTheSplitFormAndProjectsTheSum) {
   const StableNeoHookean soft(800, 0.49), stiff(5000, 0.49);
   std::vector<int> material_of(m.T.rows(), 0);
   for (Eigen::Index t = 0; t < m.T.rows(); t += 3) material_of[t] = 1;  // heterogeneous
-  std::vector<double> lambda, mu;
-  for (int k : material_of) {
-    lambda.push_back((k ? stiff : soft).lambda());
-    mu.push_back((k ? stiff : soft).mu());
-  }
-  const NodalVolumeEnergy combined(m, lambda, mu), volume(m, lambda);
+  std::vector<double> lambda;
+  for (int k : material_of) lambda.push_back((k ? stiff : soft).lambda());
+  const NodalVolumeEnergy combined(m, lambda, {soft.shear_part(), stiff.shear_part()}, material_of), volume(m, lambda);
+  EXPECT_THROW(NodalVolumeEnergy(m, lambda, {soft}), InputError);  // a volume term of its own
   const ElasticEnergy shear(m, {soft.shear_part(), stiff.shear_part()}, material_of);
   const Points x = perturbed(m, 0.004, 21);
   EXPECT_NEAR(combined.value(x), shear.value(x) + volume.value(x), 1e-12 * std::abs(combined.value(x)));

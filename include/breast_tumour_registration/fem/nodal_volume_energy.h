@@ -3,7 +3,7 @@
 // linear tetrahedra do not lock as nu -> 0.5. With the element form every tetrahedron must
 // keep its own volume: about 5 constraints per vertex against 3 degrees of freedom, and a
 // near-incompressible mesh cannot bend. Averaged over each vertex's patch there is one per
-// vertex. Together with the shear part (in this term given the shear moduli, as
+// vertex. Together with the shear part (in this term given the materials' shear parts, as
 // add_elastic_energy builds it, or as ElasticEnergy on the materials' shear_part()):
 //
 //   E = sum_t V_t [mu/2 (I_C - 3) - mu (J_t - 1)] + sum_n V_n lambda_n / 2 (Jbar_n - 1)^2,
@@ -18,7 +18,7 @@
 // plus sum_t s_t d2v_t/dx2 with s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 (indefinite;
 // eigen-clamped per element when projecting). The patches are its Hessian cliques.
 //
-// Given the shear moduli, the term carries the shear part too (add_elastic_energy does so): per
+// Given the shear parts, the term carries the shear part too (add_elastic_energy does so): per
 // element its Hessian is then V_t (mu I + (s_t - mu) d2J/dF2), projected as one matrix in closed
 // form (determinant_eigensystem.h), one 12 x 12 block per tetrahedron instead of two, and a
 // projection of the sum rather than of each part (which clamps more than it needs to).
@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "breast_tumour_registration/fem/energy_term.h"
+#include "breast_tumour_registration/fem/stable_neo_hookean.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 
 namespace btr {
@@ -36,11 +37,13 @@ class NodalVolumeEnergy : public EnergyTerm {
  public:
   /// rest    rest configuration
   /// lambda  #T volume stiffness per tetrahedron [Pa] (StableNeoHookean::lambda(), >= 0)
-  /// mu      #T shear modulus per tetrahedron [Pa] (> 0): the shear part of the stable
-  ///         Neo-Hookean energy, mu/2 (I_C - 3) - mu (J - 1), is part of this term; empty: not
-  NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<double> mu = {});
+  /// shear   the materials' shear parts (StableNeoHookean::shear_part(): mu/2 (I_C - 3) - mu (J - 1)),
+  ///         then part of this term; empty: not. InputError for a material with a volume term.
+  /// material_of  #T indices into shear (empty: all 0)
+  NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<StableNeoHookean> shear = {},
+                    std::vector<int> material_of = {});
 
-  std::string name() const override { return mu_.empty() ? "nodal volume" : "elastic (nodal volume)"; }
+  std::string name() const override { return shear_.empty() ? "nodal volume" : "elastic (nodal volume)"; }
   double value(const Points& x) const override;
   void add_gradient(const Points& x, Eigen::VectorXd& g) const override;
   void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const override;
@@ -56,7 +59,8 @@ class NodalVolumeEnergy : public EnergyTerm {
   Eigen::VectorXd element_volumes(const Points& x) const;
   Tetrahedra T_;
   std::vector<TetRestData> rest_;
-  std::vector<double> mu_;   // per tetrahedron, or empty (no shear part)
+  std::vector<StableNeoHookean> shear_;  // shear parts, or empty (no shear part)
+  std::vector<int> material_of_;         // per tetrahedron into shear_ (with shear_)
   Eigen::VectorXd Vn_;       // rest patch volume / 4 per vertex (V_n)
   Eigen::VectorXd lambda_n_;
   std::vector<std::vector<int>> patches_;    // per vertex: sorted vertices of its tetrahedra (empty: none)
