@@ -41,6 +41,9 @@ int main(int argc, char** argv) {
     if (argc > 6) ro.surface.newton.max_iterations = std::atoi(argv[6]);
     if (std::getenv("PROBE_STALL")) ro.surface.stall_projections = std::atoi(std::getenv("PROBE_STALL"));
     if (std::getenv("PROBE_ISA")) ro.surface.inversion_stall_alpha = std::atof(std::getenv("PROBE_ISA"));
+    if (std::getenv("PROBE_NPP")) ro.surface.newton_per_projection = std::atoi(std::getenv("PROBE_NPP"));
+    if (std::getenv("PROBE_CAP")) ro.surface.max_projections = std::atoi(std::getenv("PROBE_CAP"));
+    if (std::getenv("PROBE_HOLD")) ro.surface.hold_contraction = std::atof(std::getenv("PROBE_HOLD"));
     if (std::getenv("PROBE_CT")) ro.stiffness.candidate_tolerance = std::atof(std::getenv("PROBE_CT"));
     auto cb = [](const std::string& step, const IterationInfo& it) {
       if (std::getenv("PROBE_V")) std::printf("  %s it %d E %.6g |g| %.3g alpha %.3g inv %ld\n", step.c_str(), it.iteration, it.energy, it.gradient_norm, it.alpha, it.inverted);
@@ -48,7 +51,14 @@ int main(int argc, char** argv) {
     const RegistrationResult r = engine.solve(ro, cb);
     for (auto& [e, m] : r.stiffness_evaluations) std::printf("  candidate E %.1f Pa: misfit %.4f mm\n", e, m * 1e3);
     for (const auto& rep : r.reports)
+    {
       std::printf("%s: %s inv %ld %.2f s: %s\n", rep.name.c_str(), rep.converged ? "C" : "NC", rep.inverted, rep.seconds, rep.stop_reason.c_str());
+      if (std::getenv("PROBE_RES")) {
+        std::printf("  held from %d; residuals [mm]:", rep.sliding_held_from);
+        for (double q : rep.projection_residuals) std::printf(" %.3f", q * 1e3);
+        std::printf("\n");
+      }
+    }
     double w = 0; for (auto& t : r.tumours) w = std::max(w, t.centroid_distance);
     if (r.estimated_youngs_modulus > 0) std::printf("estimated E %.2f Pa\n", r.estimated_youngs_modulus);
     std::printf("worst %.4f mm, %.2f s\n", w * 1e3, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());

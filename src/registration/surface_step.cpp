@@ -146,6 +146,19 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   int fallback_at = 0;
   bool aborted = false;
   std::vector<double>& residuals = rep.projection_residuals;  // per projection [m]
+  size_t residuals_since = 0;  // the first residual of the map in use (a stall's hold starts a new one)
+  bool held_after_stall = false;
+  // SkinSliding::HeldWhereSettled: each skin vertex's sliding held from projection `outer` on, at
+  // its closest point on the scan from the state xs.
+  auto hold_sliding_at = [&](const Points& xs, int outer) {
+    rep.sliding_held_from = outer;
+    for (size_t i = 0; i < model.skin.size(); ++i) {
+      const Projection c = supine.project(P * Vec3(xs.row(model.skin[i]).transpose()));
+      anchored[i] = holds_projection(c, opt);
+      anchor[i] = c.point;
+    }
+  };
+  const bool may_hold = opt.sliding == SkinSliding::HeldWhereSettled && opt.point_weight > 0;
   for (int outer = 1; outer <= opt.max_projections; ++outer) {
     if (callback) nopt.callback = [&](const IterationInfo& it) {
       IterationInfo shifted = it;
@@ -196,7 +209,9 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     residuals.push_back(residual);
     // The contraction and the distance to the fixed point (fixed_point_estimate.h: one-step
     // ratios, or two-step ones where the residuals alternate large and small).
-    const FixedPointEstimate fp = estimate_fixed_point(residuals);
+    // (After a stall's hold the map changed: only its own residuals measure its contraction.)
+    const FixedPointEstimate fp = estimate_fixed_point(
+        std::vector<double>(residuals.begin() + static_cast<std::ptrdiff_t>(residuals_since), residuals.end()));
     const double q_hat = fp.contraction, distance = fp.distance;
     rep.projection_max_change = largest_change;
     rep.contraction = q_hat;
@@ -250,12 +265,27 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
       least_residual = residual;
       least_at = outer;
     }
+    // What a stall of a freely sliding skin calls for: its sliding held where it is, as for a
+    // creep, and the alternation goes on, with a least residual and a contraction of its own.
+    // On a scan misaligned with the chest wall (the thesis's method without its rigid step) the
+    // free skin slides on along the scan by 0.2 to 0.7 mm per projection, growing, at every E;
+    // held, it contracts within a few projections (BENCHMARKS.md, "A stall holds the sliding").
+    // Only a held skin that stalls is a stall.
+    if (outer - least_at >= opt.stall_projections && may_hold && rep.sliding_held_from == 0 && outer < opt.max_projections) {
+      hold_sliding_at(g, outer);
+      held_after_stall = true;
+      residuals_since = residuals.size();
+      least_residual = std::numeric_limits<double>::infinity();
+      least_at = outer;
+    }
     if (outer - least_at >= opt.stall_projections) {
       x = g;
       rep.stop_reason = "stalled: the skin keeps moving " + std::to_string(residual * 1e3) + " mm RMS per projection (least " +
                         std::to_string(least_residual * 1e3) + " mm, " + std::to_string(outer - least_at) +
                         " projections ago; tolerance " + std::to_string(opt.projection_tolerance * 1e3) +
-                        " mm from the fixed point): a noisy scan?";
+                        " mm from the fixed point)" +
+                        (rep.sliding_held_from > 0 ? std::string(" with its sliding held: a noisy scan, or a model that cannot reach it?")
+                                                   : std::string(": a noisy scan?"));
       break;
     }
     finished = false;
@@ -266,15 +296,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // A creep: the skin moves less than the tolerance per projection but slides on along the
     // scan at a contraction of hold_contraction or more. With HeldWhereSettled its sliding is
     // held from here: the anchors are this state's closest points.
-    if (rep.sliding_held_from == 0 && opt.sliding == SkinSliding::HeldWhereSettled && opt.point_weight > 0 && fallback_at > 0 &&
-        q_hat >= opt.hold_contraction) {
-      rep.sliding_held_from = outer;
-      for (size_t i = 0; i < model.skin.size(); ++i) {
-        const Projection c = supine.project(P * Vec3(g.row(model.skin[i]).transpose()));
-        anchored[i] = holds_projection(c, opt);
-        anchor[i] = c.point;
-      }
-    }
+    if (rep.sliding_held_from == 0 && may_hold && fallback_at > 0 && q_hat >= opt.hold_contraction) hold_sliding_at(g, outer);
     // The next iterate: Anderson's proposal where it lowers the merit without inverting more
     // elements than the plain step, else the plain step (and the history starts over).
     bool accepted = false;
@@ -311,6 +333,9 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
                       std::to_string(rep.projection_rms_change() * 1e3) + " mm RMS per projection (estimated " +
                       (std::isfinite(rep.fixed_point_distance) ? std::to_string(rep.fixed_point_distance * 1e3) + " mm" : std::string("an unknown distance")) +
                       " from the fixed point; tolerance " + std::to_string(opt.projection_tolerance * 1e3) + " mm)";
+  if (held_after_stall)
+    rep.stop_reason += "; the skin's sliding held from projection " + std::to_string(rep.sliding_held_from) +
+                       ", where it had stalled sliding freely";
   // A limit with tetrahedra inverted that the step's start did not have. Within Newton's own
   // allowance (max_inverted_fraction_after_stall of the mesh: a few elements under the skin
   // passing a nearly flat state where soft tissue meets stiff springs) it is the answer the

@@ -30,7 +30,9 @@ enum class SkinSliding {
   /// surface, the closest point the vertex had there, while the point-to-plane spring follows
   /// the projections. The alternation then minimises one energy (elastic + gravity + the skin
   /// on the scan, held along it where it settled) and contracts to its fixed point in a few
-  /// projections. Where Free contracts quickly (stiff tissue) nothing changes.
+  /// projections. Where Free contracts quickly (stiff tissue) nothing changes. A free skin that
+  /// stalls (stall_projections without a new low) is held where it is, and the alternation goes
+  /// on; only a held skin that stalls is reported as a stall.
   HeldWhereSettled,
 };
 
@@ -62,7 +64,7 @@ struct SurfaceStepOptions {
   /// surface leaves a jitter of a few hundredths of a millimetre): converged, and reported so.
   int floor_projections = 4;
   /// A stall: the skin's motion per projection has not reached a new low for this many
-  /// projections (reported as not converged).
+  /// projections (reported as not converged; with HeldWhereSettled, once the sliding is held).
   int stall_projections = 8;
   /// Projections farther than this are dropped (a partial scan, a wrong side) [m]; <= 0: keep all.
   double max_projection_distance = 0.03;
