@@ -80,7 +80,10 @@ RegistrationOptions preset_options(const std::string& name) {
   RegistrationOptions o;
   o.preset = name;
   o.landmark.newton.max_iterations = 60;
-  o.surface.max_projections = 60;
+  // 60 stopped 11 of the Table 5.1 sweep's 1 695 phantom runs from 400 Pa up while the skin was
+  // still contracting, at 0.95 a projection and within 0.13 to 0.25 mm of its fixed point
+  // (BENCHMARKS.md, "A stall holds the sliding"); a cap is a safety limit, not a budget.
+  o.surface.max_projections = 150;
   o.surface.newton_per_projection = 1;
   o.surface.newton.max_iterations = 30;
   o.simulation_cell_size = p->simulation_cell_size;
