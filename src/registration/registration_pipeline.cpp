@@ -81,7 +81,7 @@ RegistrationOptions preset_options(const std::string& name) {
   o.preset = name;
   o.landmark.newton.max_iterations = 60;
   // 60 stopped 11 of the Table 5.1 sweep's 1 695 phantom runs from 400 Pa up while the skin was
-  // still contracting, at 0.95 a projection and within 0.13 to 0.25 mm of its fixed point
+  // still contracting, at about 0.95 a projection and 0.11 to 0.24 mm from its fixed point
   // (BENCHMARKS.md, "A stall holds the sliding"); a cap is a safety limit, not a budget.
   o.surface.max_projections = 150;
   o.surface.newton_per_projection = 1;

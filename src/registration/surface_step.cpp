@@ -268,7 +268,7 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
     // What a stall of a freely sliding skin calls for: its sliding held where it is, as for a
     // creep, and the alternation goes on, with a least residual and a contraction of its own.
     // On a scan misaligned with the chest wall (the thesis's method without its rigid step) the
-    // free skin slides on along the scan by 0.2 to 0.7 mm per projection, growing, at every E;
+    // free skin slid on along the scan by 0.2 to 0.8 mm per projection, growing, from 600 Pa up;
     // held, it contracts within a few projections (BENCHMARKS.md, "A stall holds the sliding").
     // Only a held skin that stalls is a stall.
     if (outer - least_at >= opt.stall_projections && may_hold && rep.sliding_held_from == 0 && outer < opt.max_projections) {

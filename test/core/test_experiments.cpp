@@ -459,9 +459,9 @@ SoftRun soft_phantom_run(const std::string& experiment, const std::string& setti
 
 // Issue 10: a freely sliding skin that stalls is held where it stalled, and the alternation goes
 // on. The case: the thesis's method given a scan shifted 10 mm along z without the rigid step, at
-// 3400 Pa. There the free skin slid on along the scan by 0.4 to 0.8 mm per projection, growing,
-// and the step ended as a stall at every E from 600 Pa up (BENCHMARKS.md, "A stall holds the
-// sliding"). Held, it contracts to its fixed point.
+// 3400 Pa. There the free skin slid on along the scan by 0.2 to 0.4 mm per projection, growing,
+// and the step ended as a stall (as it did at every E from 600 Pa up: BENCHMARKS.md, "A stall
+// holds the sliding"). Held, it contracts to its fixed point.
 TEST(SurfaceStep, AFreeSkinThatStallsIsHeldWhereItStalledAndConverges) {
   const SoftRun s = soft_phantom_run("misalignment", "without_rigid", "translation_z_mm", "10", 3400);
   EXPECT_TRUE(s.surface.converged) << s.surface.stop_reason;
