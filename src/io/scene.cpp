@@ -42,7 +42,7 @@ namespace {
 const std::vector<std::string> kSceneKeys = {
     "units", "frame", "prone", "prone.tet_mesh", "prone.surface", "prone.cell_size_mm", "rest", "rest.tet_mesh",
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmarks.prone", "landmarks.supine", "patient_frame", "landmark_set", "landmark_vertices.*", "supine",
-    "supine.surface", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
+    "supine.surface", "supine.denoise", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
     "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "regions", "regions[]",
     "regions[].name", "regions[].youngs_modulus", "regions[].relative_stiffness", "regions[].label", "regions[].surface", "prone.cell_labels", "tumour_material",
@@ -152,6 +152,12 @@ Scene load_scene_fields(const std::string& path) {
       validate_surface(m, "supine.surface", o);
       return m;
     });
+  }
+  if (supine && supine["denoise"]) {
+    const std::string d = c.text(supine["denoise"], "supine.denoise");
+    if (d != "auto" && d != "off") c.fail("supine.denoise", "expected auto or off, got '" + d + "'");
+    if (!s.supine_surface) c.fail("supine.denoise", "denoising is for a supine.surface; there is none");
+    s.supine_denoise = d == "auto";
   }
   if (supine && supine["cloud"]) {
     if (s.supine_surface) c.fail("supine.cloud", "give supine.surface or supine.cloud, not both");

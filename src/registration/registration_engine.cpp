@@ -150,6 +150,9 @@ Scene RegistrationEngine::live_call(const Entry& e, const LiveScan& scan, const 
                                     RegistrationOptions& opt) {
   LiveScene ls = live_scene(e.prepared.scene, scan, live);
   ls.scene.preset = opt.preset;
+  // An organized scan's noise is the live path's own to filter (in its image grid, where the
+  // depth camera's per-pixel noise is independent): the mesh denoising stays out of it.
+  if (scan.width > 0) ls.scene.supine_denoise = false;
   opt.known_supine_to_model = ls.known_supine_to_model;
   opt.known_pose_covariance = ls.known_pose_covariance;
   return std::move(ls.scene);

@@ -1,7 +1,9 @@
 #include <chrono>
+#include <cmath>
 
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/geometry/surface_denoising.h"
 #include "breast_tumour_registration/registration/registration_step.h"
 #include "breast_tumour_registration/registration/rigid_regions.h"
 
@@ -214,10 +216,20 @@ void StepContext::start_positions() {
 
 const SurfaceProjector* StepContext::supine() {
   if (!supine_) {
-    if (scene.supine_surface)
-      supine_ = make_mesh_projector(transform_surface(supine_to_model, *scene.supine_surface), opt.surface.target_normals);
-    else if (scene.supine_cloud)
+    if (scene.supine_surface) {
+      SurfaceMesh surface = transform_surface(supine_to_model, *scene.supine_surface);
+      if (scene.supine_denoise && opt.surface.scan_denoising_min_noise > 0) {
+        const double noise = estimate_surface_noise(surface);  // a rigid motion keeps it
+        result.supine_noise = std::isfinite(noise) ? noise : 0.0;
+        if (result.supine_noise > opt.surface.scan_denoising_min_noise) {
+          surface = denoise_surface(surface, result.supine_noise);
+          result.supine_denoised = true;
+        }
+      }
+      supine_ = make_mesh_projector(surface, opt.surface.target_normals);
+    } else if (scene.supine_cloud) {
       supine_ = make_cloud_projector(transform_points(supine_to_model, *scene.supine_cloud));
+    }
   }
   return supine_.get();
 }

@@ -204,6 +204,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   }
   j["landmark_residual_mm"] = {{"mean", num(r.landmark_residual_mean * 1e3)}, {"max", num(r.landmark_residual_max * 1e3)}};
   j["skin_to_supine_surface_mm"] = {{"mean", num(r.skin_distance_mean * 1e3)}, {"max", num(r.skin_distance_max * 1e3)}};
+  if (r.supine_noise > 0)  // the surface step's scan: its noise along its normals, and whether it was denoised
+    j["supine_surface"] = {{"estimated_noise_mm", num(r.supine_noise * 1e3)}, {"denoised", r.supine_denoised}};
   j["warnings"] = r.warnings;
   j["figure"] =
       "cross_section.png: the x-z cut through the first tumour's registered centroid in the supine frame, axes in mm; "

@@ -12,6 +12,7 @@
 //   patient_frame: RAS             # matched by label; then the scene says its frame (RAS or LPS)
 //   supine:
 //     surface: supine.obj          # optional: supine surface (closed mesh or open scan)
+//     denoise: auto                # optional: auto (a noisy surface is denoised) or off
 //     cloud: scan.xyz              # optional instead of surface: unorganized points (.xyz, .ply, .obj)
 //     chest_ring: ring.obj         # optional: supine rigid region (for ICP)
 //   tumours: [{name: t1, prone: t1.obj, supine_ground_truth: t1_supine.obj}]
@@ -82,6 +83,9 @@ struct Scene {
   Points landmark_supine;                ///< supine landmark positions (supine frame), one row per anchor
   std::optional<SurfaceMesh> supine_surface;  ///< supine frame
   std::optional<Points> supine_cloud;         ///< supine frame; used when there is no supine_surface
+  /// `supine.denoise: auto | off`: whether a noisy supine surface may be denoised before the
+  /// surface step (SurfaceStepOptions::scan_denoising_min_noise decides when)
+  bool supine_denoise = true;
   std::optional<SurfaceMesh> prone_rigid;     ///< model frame
   std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
   std::vector<SceneTumour> tumours;

@@ -142,11 +142,16 @@ struct RegistrationResult {
   /// empty: not estimated): StiffnessEstimate::supine_prediction
   Points stiffness_prediction;
   std::vector<StepReport> reports;
+  /// [m] the supine mesh's estimated noise along its normals (0: not estimated: no mesh, or
+  /// denoising off), and whether the surface step projected onto it denoised
+  double supine_noise = 0;
+  bool supine_denoised = false;
   Points x;                 ///< deformed vertex positions, model frame
   double seconds = 0;       ///< all steps, rigid alignment included
   std::vector<TumourResult> tumours;
   double landmark_residual_mean = 0, landmark_residual_max = 0;  ///< [m]
-  double skin_distance_mean = 0, skin_distance_max = 0;          ///< [m] to the supine surface
+  /// [m] to the supine surface as the surface step saw it (denoised where supine_denoised)
+  double skin_distance_mean = 0, skin_distance_max = 0;
   bool converged = true;
   /// The result is far from its own data (see RegistrationOptions' plausibility bounds) or
   /// the rigid pose was left undecided; `warnings` says which. btr_register exits with 5.

@@ -38,7 +38,8 @@ struct StepContext {
   bool joint_pose = false;   ///< the landmark step solves the pose (rigid from landmarks, no ICP has decided)
   Rigid to_projector = Rigid::Identity();  ///< model frame -> the supine projector's frame (the surface step's pose)
   /// The supine surface or cloud in the model frame as the pose now has it (AABB tree or
-  /// kd-tree with normals), built on first use.
+  /// kd-tree with normals), built on first use; a noisy supine mesh denoised first
+  /// (SurfaceStepOptions::scan_denoising_min_noise; result.supine_noise says what it read).
   const SurfaceProjector* supine();
 
  private:
