@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <limits>
 #include <string>
@@ -47,6 +48,36 @@ std::vector<std::vector<int>> two_rings(const std::vector<std::vector<int>>& one
     r.erase(std::remove(r.begin(), r.end(), static_cast<int>(i)), r.end());
   }
   return two;
+}
+
+// Each vertex's 2-ring and, where the noise is large beside the edges (a dense scan), every
+// vertex within `radius` of it reached over the edges through such vertices, at most `cap`
+// in all; sorted, the vertex itself left out.
+std::vector<std::vector<int>> neighbourhoods(const SurfaceMesh& s, const std::vector<std::vector<int>>& one,
+                                             const std::vector<std::vector<int>>& two, double radius, size_t cap) {
+  std::vector<std::vector<int>> hood(two);
+  std::vector<size_t> in_hood(one.size(), SIZE_MAX), seen(one.size(), SIZE_MAX);  // stamped with the vertex
+  std::vector<int> queue;
+  for (size_t i = 0; i < one.size(); ++i) {
+    std::vector<int>& h = hood[i];
+    for (int j : h) in_hood[static_cast<size_t>(j)] = i;
+    queue.assign(1, static_cast<int>(i));
+    seen[i] = i;
+    for (size_t q = 0; q < queue.size() && h.size() < cap; ++q)
+      for (int k : one[static_cast<size_t>(queue[q])]) {
+        const size_t u = static_cast<size_t>(k);
+        if (seen[u] == i) continue;
+        seen[u] = i;
+        if ((s.V.row(k) - s.V.row(static_cast<Eigen::Index>(i))).norm() > radius) continue;
+        if (in_hood[u] != i) {
+          in_hood[u] = i;
+          h.push_back(k);
+        }
+        queue.push_back(k);
+      }
+    std::sort(h.begin(), h.end());
+  }
+  return hood;
 }
 
 // A tangent frame (t, b) of the unit normal n.
@@ -168,9 +199,13 @@ SurfaceMesh denoise_surface(const SurfaceMesh& s, double noise, const SurfaceDen
       !(opt.crease_cos >= -1 && opt.crease_cos <= 1) || !(opt.max_move > 0))
     throw InputError("denoise_surface: iterations must be >= 0, range_factor and max_move > 0, normal_cos and crease_cos in [-1, 1]");
   const auto one = one_rings(s);
-  const auto two = two_rings(one);
-  const double spatial = median_edge_length(s);
-  if (!(spatial > 0)) return s;  // no face of non-zero size: nothing to fit
+  const double edge = median_edge_length(s);
+  if (!(edge > 0)) return s;  // no face of non-zero size: nothing to fit
+  // The fit's scale: the edge length, or twice the noise where that is larger (a dense scan:
+  // with 1.2 mm edges the 2-ring alone left 0.80 of 1 mm of noise); its neighbourhood: the
+  // 2-ring and whatever lies within 4 noise sds (on a coarse mesh, nothing more).
+  const double spatial = std::max(edge, 2 * noise);
+  const auto two = neighbourhoods(s, one, two_rings(one), 4 * noise, 256);
   const double range = opt.range_factor * noise, cap = opt.max_move * noise;
   SurfaceMesh out = s;
   for (int pass = 0; pass < opt.iterations; ++pass) {

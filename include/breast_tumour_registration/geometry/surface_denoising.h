@@ -1,9 +1,10 @@
 // A noisy supine mesh (a scanner's surface, a reconstructed depth mesh, the calibration's
 // noisy copies) denoised along its normals before the surface step projects onto it.
 //
-// Each vertex is moved along its normal onto a local quadric (a height field over its 2-ring in
-// its own tangent frame) fitted by iteratively reweighted least squares: spatial weights a
-// Gaussian of the tangent distance (sigma: the mesh's median edge length), range weights a
+// Each vertex is moved along its normal onto a local quadric (a height field in its own tangent
+// frame over its 2-ring, and on a dense mesh over whatever lies within 4 noise sds) fitted by
+// iteratively reweighted least squares: spatial weights a Gaussian of the tangent distance
+// (sigma: the mesh's median edge length, or twice the noise where larger), range weights a
 // Gaussian of each neighbour's residual (sigma: range_factor times the noise), and only
 // neighbours whose smoothed normal is within acos(normal_cos) of the vertex's take part. So the
 // skin's curvature is kept (a quadric fits it: on the noise-free SfePy scan the filter moves
