@@ -8,8 +8,8 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/parallel_for.h"
 #include "breast_tumour_registration/fem/determinant_eigensystem.h"
-#include "breast_tumour_registration/fem/material_assignment.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
+#include "breast_tumour_registration/fem/material_assignment.h"
 #include "breast_tumour_registration/fem/small_matrices.h"
 
 namespace btr {
@@ -24,6 +24,8 @@ NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<doub
     if (shear_[k].lambda() != 0)
       throw InputError("NodalVolumeEnergy: material " + std::to_string(k) +
                        " has a volume term of its own (give its shear_part(): the volume term is this term's)");
+  if (shear_.empty() && !material_of_.empty())
+    throw InputError("NodalVolumeEnergy: a material per tetrahedron was given without the materials' shear parts to index");
   if (!shear_.empty()) material_of_ = checked_material_of(std::move(material_of_), shear_.size(), T_.rows(), "NodalVolumeEnergy");
   const Eigen::Index nv = rest.V.rows();
   Vn_ = Eigen::VectorXd::Zero(nv);

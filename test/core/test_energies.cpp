@@ -191,6 +191,7 @@ TEST(NodalVolumeEnergy, WithTheShearPartItEqualsTheSplitFormAndProjectsTheSum) {
   for (int k : material_of) lambda.push_back((k ? stiff : soft).lambda());
   const NodalVolumeEnergy combined(m, lambda, {soft.shear_part(), stiff.shear_part()}, material_of), volume(m, lambda);
   EXPECT_THROW(NodalVolumeEnergy(m, lambda, {soft}), InputError);  // a volume term of its own
+  EXPECT_THROW(NodalVolumeEnergy(m, lambda, {}, material_of), InputError);  // materials with nothing to index
   const ElasticEnergy shear(m, {soft.shear_part(), stiff.shear_part()}, material_of);
   const Points x = perturbed(m, 0.004, 21);
   EXPECT_NEAR(combined.value(x), shear.value(x) + volume.value(x), 1e-12 * std::abs(combined.value(x)));

@@ -39,7 +39,7 @@ class NodalVolumeEnergy : public EnergyTerm {
   /// lambda  #T volume stiffness per tetrahedron [Pa] (StableNeoHookean::lambda(), >= 0)
   /// shear   the materials' shear parts (StableNeoHookean::shear_part(): mu/2 (I_C - 3) - mu (J - 1)),
   ///         then part of this term; empty: not. InputError for a material with a volume term.
-  /// material_of  #T indices into shear (empty: all 0)
+  /// material_of  #T indices into shear (empty: all 0; given without shear: InputError)
   NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<StableNeoHookean> shear = {},
                     std::vector<int> material_of = {});
 
