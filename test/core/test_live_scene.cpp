@@ -6,8 +6,10 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/organized_cloud.h"
+#include "breast_tumour_registration/geometry/surface_denoising.h"
 #include "breast_tumour_registration/geometry/surface_projector.h"
 #include "breast_tumour_registration/registration/live_scene.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/simulation/depth_camera.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
@@ -141,4 +143,34 @@ TEST(LiveScene, DepthNoiseIsEstimatedAndOnlyANoisyScanIsSmoothed) {
   const LiveScene b = live_scene(s, scan);
   EXPECT_FALSE(b.smoothed);
   expect_throw_with<InputError>([&] { smooth_organized(clean, cam.width + 1, cam.height, 2.0); }, "not 161 x 120");
+}
+
+// A live organized scan keeps the live path's own filter (its image grid): the pipeline's mesh
+// denoising (surface_denoising.h) stays out of it, even where the image-grid smoothing is off
+// and the scan is noisy.
+TEST(LiveScene, ALiveScanIsNotDenoisedAgainAsAMesh) {
+  const Scene& s = btr::test::coarse_phantom_scene();
+  const Vec3 centre = s.supine_surface->V.colwise().mean().transpose();
+  PinholeCamera cam;
+  cam.width = 80;
+  cam.height = 60;
+  cam.fx = cam.fy = 70;
+  cam.cx = 39.5;
+  cam.cy = 29.5;
+  const Rigid camera = look_at(centre + Vec3(0, 0, 0.4), centre, Vec3(0, 1, 0));
+  Points cloud = render_depth({&*s.supine_surface}, cam, camera);
+  std::mt19937 rng(5);
+  add_depth_noise(cloud, 1.5e-3, rng);
+  LiveScan scan;
+  scan.cloud = transform_points(camera, cloud);
+  scan.width = cam.width;
+  scan.height = cam.height;
+  LiveSceneOptions live;
+  live.smoothing_pixels = 0;
+  RegistrationEngine engine(s);
+  const RegistrationResult r = engine.solve_live(scan, live, preset_options("fast"));
+  EXPECT_EQ(r.supine_noise, 0);
+  EXPECT_FALSE(r.supine_denoised);
+  // The same triangulated scan given as a scene's supine mesh reads as noisy.
+  EXPECT_GT(estimate_surface_noise(triangulate_organized(scan.cloud, cam.width, cam.height)), 0.8e-3);
 }
