@@ -7,11 +7,13 @@
 // (sigma: the mesh's median edge length, or twice the noise where larger), range weights a
 // Gaussian of each neighbour's residual (sigma: range_factor times the noise), and only
 // neighbours whose smoothed normal is within acos(normal_cos) of the vertex's take part. So the
-// skin's curvature is kept (a quadric fits it: on the noise-free SfePy scan the filter moves
-// vertices by 0.04 mm RMS), and where the skin meets the chest wall at a crease the other side
-// is left out instead of being averaged in. CGAL's jet smoothing (a quadric without the range
-// and normal weights) and bilateral point-set smoothing moved that crease by up to 2.5 mm on the
-// noise-free scan (BENCHMARKS.md, issue 14, 2026-12-05): hence this filter.
+// skin's curvature is kept (a quadric fits it: on the noise-free SfePy scan the filter, told of
+// 0.25 mm of noise, moves vertices by 0.03 mm RMS), and where the skin meets the chest wall at
+// a crease the other side is left out instead of being averaged in, and the crease's own
+// vertices stay. CGAL's jet smoothing (a quadric without the range and normal weights) moved
+// that crease by up to 2.5 mm on the noise-free scan, and its bilateral point-set smoothing slid
+// points along the surface and left a noisy copy farther from the truth (BENCHMARKS.md, issue
+// 14, 2026-12-05): hence this filter.
 #pragma once
 
 #include "breast_tumour_registration/base/types.h"
@@ -23,7 +25,7 @@ namespace btr {
 /// of the shape; over each edge the difference of its two ends' heights, divided by the sd it
 /// has under independent noise of sd 1 (the fits share vertices; computed from the fits'
 /// weights), has the noise's sd, and a smooth shape's remainder cancels in it. Robustly:
-/// 1.4826 times the median of their absolute values. 1 mm of noise reads 1.00 to 1.10 mm on the
+/// 1.4826 times the median of their absolute values. 1 mm of noise reads 0.99 to 1.13 mm on the
 /// phantom's and SfePy's scans; noise-free scans read 0.01 to 0.03 mm (SfePy), 0.07 to 0.09 mm
 /// (the TetGen body) and 0.02 to 0.23 mm (the 8 mm phantom, 12 000 to 300 Pa): the facets of a
 /// coarse, strongly deformed mesh are roughness at the scale of a vertex, like noise (0.54 to
