@@ -1,9 +1,9 @@
 // What the supine mesh denoising (geometry/surface_denoising.h) does to a scan: a noise-free
 // surface's noise estimate and how far the filter moves it when told of noise it does not have,
 // and, for per-vertex noise along the normals (sd given, seeds 1 to 5), the estimate and the RMS
-// distance to the noise-free vertices before and after (whole surface, and the vertices where
-// the smoothed normal turns by more than 45 degrees within the 1-ring: the crease).
-//   L=build/ws/devel/lib; g++ -std=c++17 -O2 -Iinclude -I/usr/include/eigen3 bench/probes/denoise_quality.cpp \
+// distance to the noise-free vertices before and after (whole surface, and the crease: vertices
+// whose noise-free normal and a face neighbour's differ by more than 45 degrees), and the time.
+//   L=build/ws/devel/lib; g++ -std=c++17 -O2 -Iinclude -I/usr/include/eigen3 bench/probes/denoise_quality.cpp
 //     -o /tmp/denoise_quality -L$L -lbtr_simulation -lbtr_registration -lbtr_io -lbtr_geometry -lbtr_fem -lbtr_base -Wl,-rpath,$PWD/$L
 //   /tmp/denoise_quality test/data/independent_truth_E1000/supine.obj 0.5 1 2
 #include <chrono>
