@@ -23,8 +23,9 @@ namespace {
 
 
 // The supine skin seen by a camera 0.4 m above the breast, in the working frame, where the
-// scene's supine frame sits at `supine_to_working`.
-LiveScan scan_of(const Scene& s, const Rigid& supine_to_working) {
+// scene's supine frame sits at `supine_to_working`; with `depth_noise` [m] along each pixel's
+// ray (add_depth_noise, seeded).
+LiveScan scan_of(const Scene& s, const Rigid& supine_to_working, double depth_noise = 0, unsigned seed = 5) {
   const SurfaceMesh skin = transform_surface(supine_to_working, *s.supine_surface);
   const Vec3 centre = skin.V.colwise().mean().transpose();
   PinholeCamera cam;
@@ -34,8 +35,13 @@ LiveScan scan_of(const Scene& s, const Rigid& supine_to_working) {
   cam.cx = 39.5;
   cam.cy = 29.5;
   const Rigid camera_to_working = look_at(centre + supine_to_working.linear() * Vec3(0, 0, 0.4), centre, Vec3(0, 1, 0));
+  Points cloud = render_depth({&skin}, cam, camera_to_working);
+  if (depth_noise > 0) {
+    std::mt19937 rng(seed);
+    add_depth_noise(cloud, depth_noise, rng);
+  }
   LiveScan scan;
-  scan.cloud = transform_points(camera_to_working, render_depth({&skin}, cam, camera_to_working));
+  scan.cloud = transform_points(camera_to_working, cloud);
   scan.width = cam.width;
   scan.height = cam.height;
   scan.supine_to_working = supine_to_working;
@@ -150,21 +156,7 @@ TEST(LiveScene, DepthNoiseIsEstimatedAndOnlyANoisyScanIsSmoothed) {
 // and the scan is noisy.
 TEST(LiveScene, ALiveScanIsNotDenoisedAgainAsAMesh) {
   const Scene& s = btr::test::coarse_phantom_scene();
-  const Vec3 centre = s.supine_surface->V.colwise().mean().transpose();
-  PinholeCamera cam;
-  cam.width = 80;
-  cam.height = 60;
-  cam.fx = cam.fy = 70;
-  cam.cx = 39.5;
-  cam.cy = 29.5;
-  const Rigid camera = look_at(centre + Vec3(0, 0, 0.4), centre, Vec3(0, 1, 0));
-  Points cloud = render_depth({&*s.supine_surface}, cam, camera);
-  std::mt19937 rng(5);
-  add_depth_noise(cloud, 1.5e-3, rng);
-  LiveScan scan;
-  scan.cloud = transform_points(camera, cloud);
-  scan.width = cam.width;
-  scan.height = cam.height;
+  const LiveScan scan = scan_of(s, Rigid::Identity(), 1.5e-3);
   LiveSceneOptions live;
   live.smoothing_pixels = 0;
   RegistrationEngine engine(s);
@@ -172,5 +164,5 @@ TEST(LiveScene, ALiveScanIsNotDenoisedAgainAsAMesh) {
   EXPECT_EQ(r.supine_noise, 0);
   EXPECT_FALSE(r.supine_denoised);
   // The same triangulated scan given as a scene's supine mesh reads as noisy.
-  EXPECT_GT(estimate_surface_noise(triangulate_organized(scan.cloud, cam.width, cam.height)), 0.8e-3);
+  EXPECT_GT(estimate_surface_noise(triangulate_organized(scan.cloud, scan.width, scan.height)), 0.8e-3);
 }
