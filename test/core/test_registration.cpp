@@ -1,5 +1,6 @@
 // The registration method (thesis Ch. 4) on small phantoms, with real assertions on the error.
 #include <filesystem>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <limits>
@@ -19,6 +20,7 @@
 #include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/registration/icp_alignment.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
+#include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 #include "test_util.h"
@@ -309,6 +311,27 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   EXPECT_NEAR(r.estimated_youngs_modulus, 600, 60);
   EXPECT_LT(worst_error(r), 0.5e-3);
   EXPECT_TRUE(r.converged);
+  // The grid (8 log-spaced points over the default 150 to 24000 Pa, from the stiff end) stops at
+  // its first candidate above 1.5x the best misfit: that bracket is all the refinement needs,
+  // and a softer candidate would be the search's costliest.
+  {
+    const StiffnessOptions so;
+    std::vector<std::pair<double, double>> grid;
+    for (const auto& [e, m] : r.stiffness_evaluations)
+      for (int i = 0; i < so.grid_points; ++i) {
+        const double g = std::exp(std::log(so.min_youngs_modulus) +
+                                  std::log(so.max_youngs_modulus / so.min_youngs_modulus) * i / (so.grid_points - 1));
+        if (std::abs(e / g - 1) < 1e-9) grid.emplace_back(e, m);
+      }
+    ASSERT_GE(grid.size(), 3u);
+    double best = grid[0].second;
+    for (size_t i = 1; i + 1 < grid.size(); ++i) {
+      EXPECT_LT(grid[i].first, grid[i - 1].first);
+      EXPECT_LE(grid[i].second, 1.5 * best) << "the grid went on past a candidate 1.5x the best at " << grid[i].first << " Pa";
+      best = std::min(best, grid[i].second);
+    }
+    EXPECT_GT(grid.back().second, 1.5 * best);
+  }
   // Issue 14: the estimate's own spread (1.5 mm landmarks) replaces the range's in the region:
   // far narrower than the range's sd of ln E (0.78 for 200 to 3000 Pa), and it holds the truth.
   const double sd = r.estimated_youngs_modulus_log_sd;
