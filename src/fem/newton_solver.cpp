@@ -7,6 +7,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/blas_threads.h"
+#include "breast_tumour_registration/fem/heap_retention.h"
 #include "breast_tumour_registration/fem/line_search.h"
 #include "breast_tumour_registration/fem/pcg.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
@@ -298,6 +299,7 @@ class SparseCholeskySolve : public NewtonLinearSolve {
  public:
   SparseCholeskySolve() {
     use_single_threaded_blas();
+    keep_freed_heap_memory();
     // A failed factorization is expected (the unprojected Hessian tried near the solution) and
     // handled by the driver; CHOLMOD's own "not positive definite" lines on stderr would only alarm.
     llt_.cholmod().print = 0;

@@ -11,6 +11,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/blas_threads.h"
+#include "breast_tumour_registration/fem/heap_retention.h"
 #include "breast_tumour_registration/fem/gmres.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
@@ -311,6 +312,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   jac.add(springs);
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
   use_single_threaded_blas();
+  keep_freed_heap_memory();
   Llt llt;
   // An element compressed past its stable range makes the exact Hessian indefinite there; the
   // projected one is a bound on the stiffness, so the spread it gives is a lower bound.

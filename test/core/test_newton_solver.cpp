@@ -1,10 +1,16 @@
 #include <dlfcn.h>
 
 #include <cstdlib>
+#include <cstring>
+#include <vector>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/blas_threads.h"
+#include "breast_tumour_registration/fem/heap_retention.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/line_search.h"
@@ -194,4 +200,29 @@ TEST(NewtonSolver, RunsOpenBlasOnOneThreadUnlessTheEnvironmentSays) {
     EXPECT_TRUE(use_single_threaded_blas());
     EXPECT_EQ(get(), 1);
   }
+}
+
+// Freed memory stays in the process once a Newton solver exists: a 16 MB block is served from
+// the heap, not mapped afresh, so repeated factorizations do not fault their workspace in again
+// (BENCHMARKS.md, "The stiffness search and the heap"). A malloc setting in the environment rules
+// instead.
+TEST(NewtonSolver, KeepsFreedHeapMemoryUnlessTheEnvironmentSays) {
+#if !defined(__GLIBC__)
+  GTEST_SKIP() << "the allocator is not glibc's";
+#else
+  const TetMesh m = make_box_tet_mesh(1, 1, 1, Vec3(0.1, 0.1, 0.1));
+  NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.V.rows()), m.T, std::vector<bool>{}), m.T);
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if ((tunables && std::strstr(tunables, "glibc.malloc.")) || std::getenv("MALLOC_MMAP_THRESHOLD_") ||
+      std::getenv("MALLOC_TRIM_THRESHOLD_")) {
+    EXPECT_FALSE(keep_freed_heap_memory());
+    return;
+  }
+  EXPECT_TRUE(keep_freed_heap_memory());
+  const size_t mapped = mallinfo2().hblkhd;
+  auto block = std::make_unique<std::vector<char>>(16u << 20, 1);
+  EXPECT_EQ(mallinfo2().hblkhd, mapped) << "a 16 MB block was mapped on its own";
+  block.reset();
+  EXPECT_GE(mallinfo2().fordblks, 16u << 20) << "a freed 16 MB block left the heap";
+#endif
 }
