@@ -12,6 +12,7 @@
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/rigid_transform.h"
 #include "breast_tumour_registration/registration/step_solvers.h"
+#include "breast_tumour_registration/registration/stiffness_grid_walk.h"
 #include "breast_tumour_registration/registration/unload_step.h"
 
 namespace btr {
@@ -75,8 +76,6 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   if (anchors.size() < 3 || supine.rows() != static_cast<Eigen::Index>(anchors.size()))
     throw InputError("stiffness: estimating the Young's modulus needs >= 3 landmark pairs, got " +
                      std::to_string(std::min<size_t>(anchors.size(), static_cast<size_t>(supine.rows()))));
-  if (!(opt.min_youngs_modulus > 0) || !(opt.max_youngs_modulus > 1.5 * opt.min_youngs_modulus) || opt.grid_points < 3)
-    throw InputError("stiffness: the range must satisfy 0 < min < max / 1.5 [Pa], with >= 3 grid points");
   const double E0 = model.material.youngs_modulus;
   const TetMesh prone{model.prone, model.rest.T};
   StiffnessEstimate est;
@@ -176,22 +175,15 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     return c;
   };
 
-  // The grid, from the stiff end; stop once past a clear minimum: a candidate whose misfit is
-  // above 1.5x the best's. That brackets the minimum (refined below); the next softer candidate
-  // would be the costliest of the search (on SfePy's fat-1000 body, nodal volume form: 3.1 of
-  // 8.3 s) and changes the estimate only where the misfit rises and then falls again.
+  // The grid walk (stiffness_grid_walk.h): the candidates before the refinement, stiff to soft.
   const double lo = std::log(opt.min_youngs_modulus), hi = std::log(opt.max_youngs_modulus);
-  std::vector<double> grid_u;
   std::vector<Candidate> grid;
-  int best = -1;
-  for (int i = opt.grid_points - 1; i >= 0; --i) {
-    const double u = lo + (hi - lo) * i / (opt.grid_points - 1);
-    grid_u.push_back(u);
+  const StiffnessGridWalk walk = walk_stiffness_grid(opt.min_youngs_modulus, opt.max_youngs_modulus, opt.grid_points, [&](double u) {
     grid.push_back(evaluate(std::exp(u)));
-    const int j = static_cast<int>(grid.size()) - 1;
-    if (best < 0 || grid[j].misfit < grid[best].misfit) best = j;
-    else if (std::isfinite(grid[best].misfit) && grid[j].misfit > 1.5 * grid[best].misfit) break;
-  }
+    return grid.back().misfit;
+  });
+  const std::vector<double>& grid_u = walk.log_youngs_modulus;
+  const int best = walk.best;
   if (best < 0 || !std::isfinite(grid[best].misfit))
     throw SolverError("stiffness: no candidate Young's modulus from " + pascal(opt.min_youngs_modulus) + " to " +
                       pascal(opt.max_youngs_modulus) + " could be unloaded and simulated");

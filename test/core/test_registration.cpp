@@ -20,6 +20,7 @@
 #include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/registration/icp_alignment.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
+#include "breast_tumour_registration/registration/stiffness_grid_walk.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
@@ -311,26 +312,30 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   EXPECT_NEAR(r.estimated_youngs_modulus, 600, 60);
   EXPECT_LT(worst_error(r), 0.5e-3);
   EXPECT_TRUE(r.converged);
-  // The grid (8 log-spaced points over the default 150 to 24000 Pa, from the stiff end) stops at
-  // its first candidate above 1.5x the best misfit: that bracket is all the refinement needs,
-  // and a softer candidate would be the search's costliest.
+  // The grid walk (8 log-spaced points over the default 150 to 24000 Pa from the stiff end, and
+  // the point halfway to the next where the last three put a parabola's minimum before it) stops
+  // at its first candidate past the minimum: a halfway point above the best, or a grid point
+  // above 1.5x it. None before it is past 1.5x the best (that bracket is all the refinement
+  // needs; a softer candidate would be the search's costliest). The refinement comes after, its
+  // candidates inside the bracket, so the walk is the evaluations while E falls.
   {
     const StiffnessOptions so;
-    std::vector<std::pair<double, double>> grid;
-    for (const auto& [e, m] : r.stiffness_evaluations)
-      for (int i = 0; i < so.grid_points; ++i) {
-        const double g = std::exp(std::log(so.min_youngs_modulus) +
-                                  std::log(so.max_youngs_modulus / so.min_youngs_modulus) * i / (so.grid_points - 1));
-        if (std::abs(e / g - 1) < 1e-9) grid.emplace_back(e, m);
-      }
-    ASSERT_GE(grid.size(), 3u);
-    double best = grid[0].second;
-    for (size_t i = 1; i + 1 < grid.size(); ++i) {
-      EXPECT_LT(grid[i].first, grid[i - 1].first);
-      EXPECT_LE(grid[i].second, 1.5 * best) << "the grid went on past a candidate 1.5x the best at " << grid[i].first << " Pa";
-      best = std::min(best, grid[i].second);
+    const auto& ev = r.stiffness_evaluations;
+    size_t walk = 1;
+    while (walk < ev.size() && ev[walk].first < ev[walk - 1].first) ++walk;
+    ASSERT_GE(walk, 3u);
+    double best = ev[0].second;
+    for (size_t i = 1; i + 1 < walk; ++i) {
+      EXPECT_LE(ev[i].second, 1.5 * best) << "the walk went on past a candidate 1.5x the best at " << ev[i].first << " Pa";
+      best = std::min(best, ev[i].second);
     }
-    EXPECT_GT(grid.back().second, 1.5 * best);
+    const double last = ev[walk - 1].first;
+    bool on_grid = false;
+    for (int i = 0; i < so.grid_points; ++i)
+      on_grid = on_grid || std::abs(last / std::exp(std::log(so.min_youngs_modulus) + std::log(so.max_youngs_modulus / so.min_youngs_modulus) *
+                                                                   i / (so.grid_points - 1)) - 1) < 1e-9;
+    EXPECT_GT(ev[walk - 1].second, (on_grid ? 1.5 : 1.0) * best) << "the walk stopped at " << last << " Pa";
+    for (size_t i = walk; i < ev.size(); ++i) EXPECT_GT(ev[i].first, last) << "a refinement candidate outside the bracket";
   }
   // Issue 14: the estimate's own spread (1.5 mm landmarks) replaces the range's in the region:
   // far narrower than the range's sd of ln E (0.78 for 200 to 3000 Pa), and it holds the truth.
@@ -881,4 +886,48 @@ TEST(SurfaceStep, OptionsOutOfRangeAreNamed) {
   o = SurfaceStepOptions{};
   o.stall_projections = 0;
   expect_throw_with<InputError>([&] { surface_step(m, *supine, o, x); }, "stall_projections");
+}
+
+// The stiffness search's grid walk on misfits known in closed form (stiffness_grid_walk.h).
+TEST(Stiffness, TheGridWalkStopsPastTheMinimumAndSparesTheSoftEnd) {
+  const double lo = 150, hi = 24000;
+  const int n = 8;
+  auto on_grid = [&](double u) {
+    for (int i = 0; i < n; ++i)
+      if (std::abs(u - (std::log(lo) + std::log(hi / lo) * i / (n - 1))) < 1e-12) return true;
+    return false;
+  };
+  // Misfit growing linearly in |ln E - ln E*| (its square a parabola), minimum at 330 Pa: the
+  // parabola through 1320, 640 and 310 Pa puts it before the grid's 150 Pa, so the point halfway
+  // (215 Pa) is tried and, above the best, ends the walk; 150 Pa (the costly one) never is.
+  int calls = 0;
+  const StiffnessGridWalk soft = walk_stiffness_grid(lo, hi, n, [&](double u) {
+    ++calls;
+    return 1e-3 * std::abs(u - std::log(330.0));
+  });
+  ASSERT_EQ(soft.log_youngs_modulus.size(), soft.misfit.size());
+  EXPECT_EQ(calls, static_cast<int>(soft.misfit.size()));
+  for (double u : soft.log_youngs_modulus) EXPECT_GT(std::exp(u), 200) << "the soft end was simulated";
+  EXPECT_NEAR(std::exp(soft.log_youngs_modulus.back()), std::sqrt(309.7 * 150.0), 1.0);
+  EXPECT_FALSE(on_grid(soft.log_youngs_modulus.back()));
+  EXPECT_NEAR(std::exp(soft.log_youngs_modulus[soft.best]), 309.7, 0.1);
+  EXPECT_EQ(soft.best, static_cast<int>(soft.misfit.size()) - 2);  // bracketed: both neighbours simulated
+  // The walk only falls, one candidate per grid point or halfway point.
+  for (size_t i = 1; i < soft.log_youngs_modulus.size(); ++i)
+    EXPECT_LT(soft.log_youngs_modulus[i], soft.log_youngs_modulus[i - 1]);
+
+  // A misfit whose square is linear (no curvature to predict a minimum from): the grid alone,
+  // stopped at its first point above 1.5x the best.
+  const StiffnessGridWalk plain = walk_stiffness_grid(lo, hi, n, [](double u) { return 1e-3 * std::sqrt(std::abs(u - std::log(1000.0))); });
+  for (double u : plain.log_youngs_modulus) EXPECT_TRUE(on_grid(u)) << std::exp(u) << " Pa";
+  EXPECT_GT(plain.misfit.back(), 1.5 * plain.misfit[plain.best]);
+  for (int i = plain.best + 1; i + 1 < static_cast<int>(plain.misfit.size()); ++i) EXPECT_LE(plain.misfit[i], 1.5 * plain.misfit[plain.best]);
+  EXPECT_NEAR(std::exp(plain.log_youngs_modulus[plain.best]), 1320.4, 0.1);
+
+  // A minimum beyond the soft end: every grid point, the last the best.
+  const StiffnessGridWalk beyond = walk_stiffness_grid(lo, hi, n, [](double u) { return 1e-3 * std::abs(u - std::log(50.0)); });
+  EXPECT_EQ(std::exp(beyond.log_youngs_modulus[beyond.best]), std::exp(beyond.log_youngs_modulus.back()));
+  EXPECT_NEAR(std::exp(beyond.log_youngs_modulus.back()), lo, 1e-9);
+
+  expect_throw_with<InputError>([&] { walk_stiffness_grid(100, 120, n, [](double) { return 0.0; }); }, "0 < min < max / 1.5");
 }

@@ -9,8 +9,8 @@
 // under the supine gravity; the objective is the RMS misfit of the landmarks so predicted to
 // the supine landmarks after their best rigid fit (Kabsch), so it does not depend on the pose.
 // The search is a log-spaced grid from the stiff end, stopped once the misfit has clearly
-// passed its minimum (the soft candidates are the costly ones), then parabolic refinement in
-// log E around the best point. Equilibrium is invariant under scaling E and gravity together,
+// passed its minimum (the soft candidates are the costly ones; stiffness_grid_walk.h), then
+// parabolic refinement in log E around the best point. Equilibrium is invariant under scaling E and gravity together,
 // so a candidate is simulated with the gravities divided by the factor.
 #pragma once
 

@@ -1,0 +1,33 @@
+// The stiffness search's first phase (stiffness_step.h): which candidate moduli to simulate
+// before the refinement. A log-spaced grid from the stiff end, stopped once past a clear minimum
+// of the landmark misfit: a candidate above 1.5x the best's. That brackets the minimum; the next
+// softer candidate would be the costliest of the search (on SfePy's fat-1000 body with the nodal
+// volume term: 3.1 of 8.3 s) and changes the estimate only where the misfit rises and then falls
+// again.
+//
+// Softer candidates cost more, steeply at the soft end, where the unload needs load
+// continuation: on SfePy's fat-300 body with the nodal volume term the 150 Pa candidate took two
+// minutes, the 310 Pa one 1.5 s. So where the last three candidates, still falling, put a convex
+// parabola's minimum (in log E, on the squared misfit) before the next grid point, the point
+// halfway to it is tried first. Above the best, it brackets the minimum on its own (the rise the
+// parabola predicted; no 1.5x margin needed); below, it is the best and the grid goes on.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+namespace btr {
+
+struct StiffnessGridWalk {
+  std::vector<double> log_youngs_modulus;  ///< ln E [Pa] of every candidate, in the order simulated (falling)
+  std::vector<double> misfit;              ///< [m] as misfit_at returned it (infinite: the candidate failed)
+  int best = -1;                           ///< index of the least misfit (the first, if none is finite)
+};
+
+/// Walks `grid_points` log-spaced moduli from max_youngs_modulus down to min_youngs_modulus,
+/// calling misfit_at(ln E) for each candidate it simulates. InputError for a range that is not
+/// 0 < min < max / 1.5 or fewer than 3 grid points.
+StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points,
+                                      const std::function<double(double)>& misfit_at);
+
+}  // namespace btr

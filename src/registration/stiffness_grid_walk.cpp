@@ -1,0 +1,45 @@
+#include "breast_tumour_registration/registration/stiffness_grid_walk.h"
+
+#include <cmath>
+
+#include "breast_tumour_registration/base/errors.h"
+
+namespace btr {
+
+StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points,
+                                      const std::function<double(double)>& misfit_at) {
+  if (!(min_youngs_modulus > 0) || !(max_youngs_modulus > 1.5 * min_youngs_modulus) || grid_points < 3)
+    throw InputError("stiffness: the range must satisfy 0 < min < max / 1.5 [Pa], with >= 3 grid points");
+  const double lo = std::log(min_youngs_modulus), hi = std::log(max_youngs_modulus);
+  const double step = (hi - lo) / (grid_points - 1);
+  StiffnessGridWalk w;
+  auto& u_of = w.log_youngs_modulus;
+  auto& f_of = w.misfit;
+  auto add = [&](double u) {
+    u_of.push_back(u);
+    f_of.push_back(misfit_at(u));
+    return static_cast<int>(u_of.size()) - 1;
+  };
+  int& best = w.best;
+  for (int i = grid_points - 1; i >= 0; --i) {
+    const double u = lo + step * i;
+    const int m = static_cast<int>(u_of.size());
+    if (m >= 3 && best == m - 1 && std::isfinite(f_of[m - 3])) {
+      const double u0 = u_of[m - 3], u1 = u_of[m - 2], u2 = u_of[m - 1];
+      const double f0 = f_of[m - 3] * f_of[m - 3], f1 = f_of[m - 2] * f_of[m - 2], f2 = f_of[m - 1] * f_of[m - 1];
+      // Divided differences of the squared misfit in u (u falling from u0 to u2).
+      const double d01 = (f1 - f0) / (u1 - u0), d12 = (f2 - f1) / (u2 - u1), curvature = 2 * (d12 - d01) / (u2 - u0);
+      if (curvature > 0 && 0.5 * (u1 + u2) - d12 / curvature > u) {  // the parabola's minimum lies before u
+        const int h = add(0.5 * (u2 + u));
+        if (f_of[h] > f_of[best]) break;
+        best = h;
+      }
+    }
+    const int j = add(u);
+    if (best < 0 || f_of[j] < f_of[best]) best = j;
+    else if (std::isfinite(f_of[best]) && f_of[j] > 1.5 * f_of[best]) break;
+  }
+  return w;
+}
+
+}  // namespace btr
