@@ -24,7 +24,7 @@ StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youn
   for (int i = grid_points - 1; i >= 0; --i) {
     const double u = lo + step * i;
     const int m = static_cast<int>(u_of.size());
-    if (m >= 3 && best == m - 1 && std::isfinite(f_of[m - 3])) {
+    if (i == 0 && m >= 3 && best == m - 1 && std::isfinite(f_of[m - 3])) {  // the next is the softest, the costliest
       const double u0 = u_of[m - 3], u1 = u_of[m - 2], u2 = u_of[m - 1];
       const double f0 = f_of[m - 3] * f_of[m - 3], f1 = f_of[m - 2] * f_of[m - 2], f2 = f_of[m - 1] * f_of[m - 1];
       // Divided differences of the squared misfit in u (u falling from u0 to u2).

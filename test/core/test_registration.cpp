@@ -916,6 +916,12 @@ TEST(Stiffness, TheGridWalkStopsPastTheMinimumAndSparesTheSoftEnd) {
   for (size_t i = 1; i < soft.log_youngs_modulus.size(); ++i)
     EXPECT_LT(soft.log_youngs_modulus[i], soft.log_youngs_modulus[i - 1]);
 
+  // The same misfit with its minimum at 1000 Pa: the parabola puts it before 640 Pa, but that is
+  // not the softest grid point, so the grid alone (stopping at 640 Pa, above 1.5x the best).
+  const StiffnessGridWalk firm = walk_stiffness_grid(lo, hi, n, [](double u) { return 1e-3 * std::abs(u - std::log(1000.0)); });
+  for (double u : firm.log_youngs_modulus) EXPECT_TRUE(on_grid(u)) << std::exp(u) << " Pa";
+  EXPECT_NEAR(std::exp(firm.log_youngs_modulus.back()), 639.5, 0.1);
+
   // A misfit whose square is linear (no curvature to predict a minimum from): the grid alone,
   // stopped at its first point above 1.5x the best.
   const StiffnessGridWalk plain = walk_stiffness_grid(lo, hi, n, [](double u) { return 1e-3 * std::sqrt(std::abs(u - std::log(1000.0))); });
