@@ -2,11 +2,11 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <vector>
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
-#include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/blas_threads.h"

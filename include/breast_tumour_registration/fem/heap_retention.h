@@ -4,8 +4,8 @@
 // factorization's workspace (CHOLMOD's transposed copy, its supernodes) and each assembler's
 // arrays are page-faulted in afresh: 12 % of a nodal-form registration's samples were in the
 // kernel's page-fault handler. Keeping freed memory in the process (mmap threshold 32 MB,
-// glibc's maximum; trim threshold 512 MB) made registrations 7 to 25 % faster on SfePy's
-// bodies for about 9 % more peak memory (BENCHMARKS.md, "The stiffness search and the heap").
+// glibc's maximum; trim threshold 512 MB) made single registrations 4 to 23 % faster on SfePy's
+// bodies for 5 to 17 MB more peak memory (BENCHMARKS.md, "The stiffness search and the heap").
 #pragma once
 
 namespace btr {

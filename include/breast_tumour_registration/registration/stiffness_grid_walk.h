@@ -12,8 +12,8 @@
 // before it, the point halfway to it is tried first. Above the best, it brackets the minimum on
 // its own (the rise the parabola predicted; no 1.5x margin needed); below, it is the best and the
 // grid goes on. Only there: elsewhere the full step is cheap, and the halfway point's narrower
-// bracket moved where the refinement's 5 % tolerance stopped (a 3400 Pa phantom estimated at
-// 3747 instead of 3552 Pa).
+// bracket moved where the refinement's 5 % tolerance stopped (a labelled 3400 Pa phantom
+// estimated at 3747 instead of 3578 Pa).
 #pragma once
 
 #include <functional>
