@@ -6,12 +6,18 @@
 
 namespace btr {
 
-StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points,
-                                      const std::function<double(double)>& misfit_at) {
+std::vector<double> stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points) {
   if (!(min_youngs_modulus > 0) || !(max_youngs_modulus > 1.5 * min_youngs_modulus) || grid_points < 3)
     throw InputError("stiffness: the range must satisfy 0 < min < max / 1.5 [Pa], with >= 3 grid points");
   const double lo = std::log(min_youngs_modulus), hi = std::log(max_youngs_modulus);
-  const double step = (hi - lo) / (grid_points - 1);
+  std::vector<double> u(static_cast<size_t>(grid_points));
+  for (int i = 0; i < grid_points; ++i) u[static_cast<size_t>(i)] = lo + (hi - lo) * (grid_points - 1 - i) / (grid_points - 1);
+  return u;
+}
+
+StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points,
+                                      const std::function<double(double)>& misfit_at) {
+  const std::vector<double> grid = stiffness_grid(min_youngs_modulus, max_youngs_modulus, grid_points);
   StiffnessGridWalk w;
   auto& u_of = w.log_youngs_modulus;
   auto& f_of = w.misfit;
@@ -21,10 +27,10 @@ StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youn
     return static_cast<int>(u_of.size()) - 1;
   };
   int& best = w.best;
-  for (int i = grid_points - 1; i >= 0; --i) {
-    const double u = lo + step * i;
+  for (size_t g = 0; g < grid.size(); ++g) {
+    const double u = grid[g];
     const int m = static_cast<int>(u_of.size());
-    if (i == 0 && m >= 3 && best == m - 1 && std::isfinite(f_of[m - 3])) {  // the next is the softest, the costliest
+    if (g + 1 == grid.size() && m >= 3 && best == m - 1 && std::isfinite(f_of[m - 3])) {  // the next is the softest, the costliest
       const double u0 = u_of[m - 3], u1 = u_of[m - 2], u2 = u_of[m - 1];
       const double f0 = f_of[m - 3] * f_of[m - 3], f1 = f_of[m - 2] * f_of[m - 2], f2 = f_of[m - 1] * f_of[m - 1];
       // Divided differences of the squared misfit in u (u falling from u0 to u2).

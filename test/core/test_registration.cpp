@@ -81,6 +81,14 @@ RegistrationResult register_scene(const std::string& path, const std::string& pr
 
 
 
+
+// Whether ln E `u` is a point of the stiffness search's grid (stiffness_grid), not a halfway point.
+bool on_stiffness_grid(double u, const std::vector<double>& grid) {
+  for (double g : grid)
+    if (std::abs(u - g) < 1e-12) return true;
+  return false;
+}
+
 }  // namespace
 
 TEST(Kabsch, RecoversAKnownRigidTransformAndRejectsBadInput) {
@@ -313,7 +321,8 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   EXPECT_LT(worst_error(r), 0.5e-3);
   EXPECT_TRUE(r.converged);
   // The grid walk (8 log-spaced points over the default 150 to 24000 Pa from the stiff end, and
-  // the point halfway to the next where the last three put a parabola's minimum before it) stops
+  // before the softest the point halfway to it where the last three put a parabola's minimum
+  // before it) stops
   // at its first candidate past the minimum: a halfway point above the best, or a grid point
   // above 1.5x it. None before it is past 1.5x the best (that bracket is all the refinement
   // needs; a softer candidate would be the search's costliest). The refinement comes after, its
@@ -330,10 +339,7 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
       best = std::min(best, ev[i].second);
     }
     const double last = ev[walk - 1].first;
-    bool on_grid = false;
-    for (int i = 0; i < so.grid_points; ++i)
-      on_grid = on_grid || std::abs(last / std::exp(std::log(so.min_youngs_modulus) + std::log(so.max_youngs_modulus / so.min_youngs_modulus) *
-                                                                   i / (so.grid_points - 1)) - 1) < 1e-9;
+    const bool on_grid = on_stiffness_grid(std::log(last), stiffness_grid(so.min_youngs_modulus, so.max_youngs_modulus, so.grid_points));
     EXPECT_GT(ev[walk - 1].second, (on_grid ? 1.5 : 1.0) * best) << "the walk stopped at " << last << " Pa";
     for (size_t i = walk; i < ev.size(); ++i) EXPECT_GT(ev[i].first, last) << "a refinement candidate outside the bracket";
   }
@@ -892,11 +898,11 @@ TEST(SurfaceStep, OptionsOutOfRangeAreNamed) {
 TEST(Stiffness, TheGridWalkStopsPastTheMinimumAndSparesTheSoftEnd) {
   const double lo = 150, hi = 24000;
   const int n = 8;
-  auto on_grid = [&](double u) {
-    for (int i = 0; i < n; ++i)
-      if (std::abs(u - (std::log(lo) + std::log(hi / lo) * i / (n - 1))) < 1e-12) return true;
-    return false;
-  };
+  const std::vector<double> grid = stiffness_grid(lo, hi, n);
+  ASSERT_EQ(grid.size(), 8u);
+  EXPECT_NEAR(grid.front(), std::log(hi), 1e-12);
+  EXPECT_NEAR(grid.back(), std::log(lo), 1e-12);
+  auto on_grid = [&](double u) { return on_stiffness_grid(u, grid); };
   // Misfit growing linearly in |ln E - ln E*| (its square a parabola), minimum at 330 Pa: the
   // parabola through 1320, 640 and 310 Pa puts it before the grid's 150 Pa, so the point halfway
   // (215 Pa) is tried and, above the best, ends the walk; 150 Pa (the costly one) never is.
@@ -932,7 +938,7 @@ TEST(Stiffness, TheGridWalkStopsPastTheMinimumAndSparesTheSoftEnd) {
 
   // A minimum beyond the soft end: every grid point, the last the best.
   const StiffnessGridWalk beyond = walk_stiffness_grid(lo, hi, n, [](double u) { return 1e-3 * std::abs(u - std::log(50.0)); });
-  EXPECT_EQ(std::exp(beyond.log_youngs_modulus[beyond.best]), std::exp(beyond.log_youngs_modulus.back()));
+  EXPECT_EQ(beyond.best, static_cast<int>(beyond.log_youngs_modulus.size()) - 1);
   EXPECT_NEAR(std::exp(beyond.log_youngs_modulus.back()), lo, 1e-9);
 
   expect_throw_with<InputError>([&] { walk_stiffness_grid(100, 120, n, [](double) { return 0.0; }); }, "0 < min < max / 1.5");

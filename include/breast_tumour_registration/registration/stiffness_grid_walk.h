@@ -27,6 +27,10 @@ struct StiffnessGridWalk {
   int best = -1;                           ///< index of the least misfit (the first, if none is finite)
 };
 
+/// The grid: ln E [Pa] of `grid_points` log-spaced moduli from max_youngs_modulus down to
+/// min_youngs_modulus, the order the walk takes them in. InputError as walk_stiffness_grid.
+std::vector<double> stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points);
+
 /// Walks `grid_points` log-spaced moduli from max_youngs_modulus down to min_youngs_modulus,
 /// calling misfit_at(ln E) for each candidate it simulates. InputError for a range that is not
 /// 0 < min < max / 1.5 or fewer than 3 grid points.
