@@ -31,8 +31,15 @@ landmark vertices, rest tumours, both gravities) and, per fat modulus, the prone
 volumes (prone_volume.vtk, supine_volume.vtk: the rest mesh's vertices moved by the P2 solution,
 the same tetrahedra); OUT/truth.yaml lists every configuration written so far.
 
+A second body shape (a figure that holds on one body may not hold on another): the same
+generator with other dimensions and tissue ratios, e.g. the deeper, narrower breast of
+BENCHMARKS.md ("A second independent body"):
+  --depth 75 --half-width 65 60 --half-height 60 --sag -10 --gland-ratio 3 --tumour-ratio 8
+
 Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
        [--max-volume 1500] [--poisson-ratio 0.49] [--linear-solver auto|mumps|scipy]
+       [--depth 60] [--half-width 85 70] [--half-height 65] [--sag 15] (lengths in mm, as
+       bench/make_shape_model.py) [--gland-ratio 2] [--tumour-ratio 6]
        (needs Debian's python3-sfepy and tetgen; python3-petsc4py for MUMPS)"""
 import argparse
 import json
@@ -284,11 +291,16 @@ def main():
     ap.add_argument('--poisson-ratio', type=float, default=0.49)
     ap.add_argument('--gland-ratio', type=float, default=2.0)
     ap.add_argument('--tumour-ratio', type=float, default=6.0)
+    ap.add_argument('--depth', type=float, default=60.0, help='A: the apex height above the chest wall [mm]')
+    ap.add_argument('--half-width', type=float, nargs=2, default=[85.0, 70.0], help='B+ B-: along +x and -x [mm]')
+    ap.add_argument('--half-height', type=float, default=65.0, help='C: along y [mm]')
+    ap.add_argument('--sag', type=float, default=15.0, help='S: the apex shifted by -S along y [mm]')
     ap.add_argument('--linear-solver', choices=('auto', 'mumps', 'scipy'), default='auto',
                     help='MUMPS (through petsc4py) when available, else SciPy')
     o = ap.parse_args()
     os.makedirs(o.out, exist_ok=True)
-    node, ele, landmarks, tumours, gland, dims = mesh_body(o.out, o.max_volume)
+    node, ele, landmarks, tumours, gland, dims = mesh_body(o.out, o.max_volume, o.depth, o.half_width[0], o.half_width[1],
+                                                       o.half_height, o.sag)
     radius = 8.0
     lab = labels(node, ele, tumours, gland, radius)
     bface = boundary(ele)
@@ -313,7 +325,8 @@ def main():
         os.makedirs(d, exist_ok=True)
         info = {'generator': 'SfePy (P2 tetrahedra, TL neo-Hookean + bulk penalty), TetGen mesh',
                 'fat_youngs_modulus_Pa': fat, 'gland_youngs_modulus_Pa': moduli[2], 'tumour_youngs_modulus_Pa': moduli[3],
-                'poisson_ratio': o.poisson_ratio, 'vertices': int(len(node)), 'tetrahedra': int(len(ele))}
+                'poisson_ratio': o.poisson_ratio, 'vertices': int(len(node)), 'tetrahedra': int(len(ele)),
+                'shape_mm': dict(zip(('depth', 'half_width_plus_x', 'half_width_minus_x', 'half_height', 'sag'), dims))}
         pos = {}
         for which, g in (('prone', (0, 0, G)), ('supine', (0, 0, -G))):
             # Newton without line search: on soft fat a quarter of gravity folds elements in the
