@@ -33,7 +33,7 @@ the same tetrahedra); OUT/truth.yaml lists every configuration written so far.
 
 A second body shape (a figure that holds on one body may not hold on another): the same
 generator with other dimensions and tissue ratios, e.g. the deeper, narrower breast of
-BENCHMARKS.md ("A second independent body"):
+BENCHMARKS.md ("The nodal volume term as the default"):
   --depth 75 --half-width 65 60 --half-height 60 --sag -10 --gland-ratio 3 --tumour-ratio 8
 
 Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
