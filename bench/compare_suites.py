@@ -10,6 +10,10 @@ centroid error [mm].
       a line per file: runs not converged, median and mean error (also without the thesis's
       misalignment runs without the rigid step), runs better / worse by more than 0.1 mm than the
       first file, and the full method's error per generating E
+  compare_suites.py --fallback A.csv B.csv
+      what "B, else A where B did not converge" would give (e.g. the nodal volume term falling back
+      to the element form): per generating E the runs not converged in A, B and the fallback, and
+      the full method's error; the summed seconds (the fallback pays A only where B failed)
 """
 import collections, csv, statistics, sys
 
@@ -43,6 +47,27 @@ def changed(a, b, by):
                   + ("" if converged(sb) else "   | " + sb[:150]))
 
 
+def fallback(a, b):
+    per = collections.defaultdict(collections.Counter)
+    full, secs = {}, collections.Counter()
+    for k in b:
+        if k not in a:
+            continue
+        ok_a, ok_b = converged(a[k][1]), converged(b[k][1])
+        pick = b[k] if ok_b else a[k]
+        c = per[k[4]]
+        c['runs'] += 1; c['a'] += not ok_a; c['b'] += not ok_b; c['fallback'] += not (ok_a or ok_b)
+        secs['a'] += a[k][2]; secs['b'] += b[k][2]; secs['fallback'] += b[k][2] + (0 if ok_b else a[k][2])
+        if k[0] == 'practical' and k[1] == 'full':
+            full[k[4]] = (a[k][0], b[k][0], pick[0])
+    print('| generating E [Pa] | not converged A / B / fallback | full method A / B / fallback [mm] |')
+    print('|---|---|---|')
+    for e in sorted(per, key=float):
+        c, f = per[e], full.get(e, (float('nan'),) * 3)
+        print(f"| {e} | {c['a']} / {c['b']} / {c['fallback']} of {c['runs']} | {f[0]:.2f} / {f[1]:.2f} / {f[2]:.2f} |")
+    print(f"seconds, summed: A {secs['a']:.0f}, B {secs['b']:.0f}, fallback {secs['fallback']:.0f}")
+
+
 def summary(named):
     base = None
     for name, path in named:
@@ -67,6 +92,8 @@ if __name__ == '__main__':
     elif args and args[0] == '--changed':
         by = float(args[args.index('--by') + 1]) if '--by' in args else 0.03
         changed(load(args[1]), load(args[2]), by)
+    elif args and args[0] == '--fallback' and len(args) == 3:
+        fallback(load(args[1]), load(args[2]))
     elif len(args) == 2:
         run_by_run(load(args[0]), load(args[1]))
     else:
