@@ -185,10 +185,10 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   Json tumours = Json::array();
   for (size_t i = 0; i < r.tumours.size(); ++i) tumours.push_back(tumour_report(r.tumours[i], r.sampled_uncertainty ? &*r.sampled_uncertainty : nullptr, i));
   j["tumours"] = tumours;
+  // What the linear region leaves out, stated where it is read: on ring-free independent truth
+  // the landmarks' direct effect was most of the error at fat 1000 to 3400 Pa (BENCHMARKS.md,
+  // "The linear region leaves out the landmarks' direct effect").
   if (!r.uncertainty_note.empty() || (!r.tumours.empty() && r.tumours[0].uncertainty))
-    // What the linear region leaves out, stated where it is read: on ring-free independent truth
-    // the landmarks' direct effect was most of the error at fat 1000 to 3400 Pa (BENCHMARKS.md,
-    // "The linear region leaves out the landmarks' direct effect").
     j["uncertainty"] = {{"method", "linear"},
                         {"validated", false},
                         {"seconds", num(r.uncertainty_seconds)},

@@ -79,9 +79,6 @@ RegistrationResult register_scene(const std::string& path, const std::string& pr
   return register_scene(path, preset_options(preset));
 }
 
-
-
-
 // Whether ln E `u` is a point of the stiffness search's grid (stiffness_grid), not a halfway point.
 bool on_stiffness_grid(double u, const std::vector<double>& grid) {
   for (double g : grid)
@@ -322,9 +319,8 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
   EXPECT_TRUE(r.converged);
   // The grid walk (8 log-spaced points over the default 150 to 24000 Pa from the stiff end, and
   // before the softest the point halfway to it where the last three put a parabola's minimum
-  // before it) stops
-  // at its first candidate past the minimum: a halfway point above the best, or a grid point
-  // above 1.5x it. None before it is past 1.5x the best (that bracket is all the refinement
+  // before it) stops at its first candidate past the minimum: a halfway point above the best, or
+  // a grid point above 1.5x it. None before it is past 1.5x the best (that bracket is all the refinement
   // needs; a softer candidate would be the search's costliest). The refinement comes after, its
   // candidates inside the bracket, so the walk is the evaluations while E falls.
   {

@@ -13,12 +13,13 @@ enum class VolumeForm { Auto, Element, Nodal };
 /// Measured (BENCHMARKS.md): the nodal form is the more accurate in bending at every nu from
 /// 0.45 to 0.4999 (a cantilever against beam theory) and on the phantom from nu = 0.499 up, and
 /// it makes a registration slower (its Hessian couples each vertex's patch: 2.2 times on SfePy's
-/// fat-1000 body with E estimated since 2026-12-05, 3.5 to 5 times before). The threshold keeps the thesis's nu = 0.49 on the element form: with the nodal
-/// form as the default (tried, BENCHMARKS.md, "The nodal volume term as the default") the suite
-/// folded coarse soft meshes on three bodies (9 to 24 of 28 runs not converged at fat 300 to
-/// 500 Pa, 0 to 4 with the element form), although from 1000 Pa up and with the full method it
-/// is the nearer model on both independent bodies. `material.volume_form: nodal` chooses it at
-/// any nu (BENCHMARKS.md, "The nodal volume term's cost").
+/// fat-1000 body with E estimated since 2026-12-05, 3.5 to 5 times before). The threshold keeps
+/// the thesis's nu = 0.49 on the element form: with the nodal form as the default (tried,
+/// BENCHMARKS.md, "The nodal volume term as the default") the suite folded coarse soft meshes on
+/// three bodies (9 to 24 of 28 runs not converged at fat 300 to 500 Pa, 0 to 4 with the element
+/// form), although from 1000 Pa up and with the full method it is the nearer model on both
+/// independent bodies. `material.volume_form: nodal` chooses it at any nu (BENCHMARKS.md, "The
+/// nodal volume term's cost").
 constexpr double kNodalVolumeFromPoisson = 0.495;
 VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio);
 /// Parses "auto", "element" or "nodal"; InputError otherwise.
