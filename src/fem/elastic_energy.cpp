@@ -1,5 +1,6 @@
 #include "breast_tumour_registration/fem/elastic_energy.h"
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
@@ -69,7 +70,9 @@ void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vec
   for (const auto& m : materials) shear.push_back(m.shear_part());
   std::vector<double> lambda(rest.T.rows());
   for (Eigen::Index t = 0; t < rest.T.rows(); ++t) lambda[t] = materials[of[t]].lambda();
-  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda, std::move(shear), std::move(of)));
+  std::vector<double> kappa(rest.T.rows());
+  for (Eigen::Index t = 0; t < rest.T.rows(); ++t) kappa[t] = std::min(kNodalElementShare * materials[of[t]].mu(), lambda[t]);
+  energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda, std::move(shear), std::move(of), kappa));
 }
 
 }  // namespace btr

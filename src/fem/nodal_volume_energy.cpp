@@ -15,7 +15,8 @@
 namespace btr {
 
 NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda,
-                                     std::vector<StableNeoHookean> shear, std::vector<int> material_of)
+                                     std::vector<StableNeoHookean> shear, std::vector<int> material_of,
+                                     const std::vector<double>& element_share)
     : T_(rest.T), rest_(compute_rest_data(rest)), shear_(std::move(shear)), material_of_(std::move(material_of)) {
   if (static_cast<Eigen::Index>(lambda.size()) != T_.rows())
     throw InputError("NodalVolumeEnergy: " + std::to_string(lambda.size()) + " volume stiffnesses for " +
@@ -24,6 +25,9 @@ NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<doub
     if (shear_[k].lambda() != 0)
       throw InputError("NodalVolumeEnergy: material " + std::to_string(k) +
                        " has a volume term of its own (give its shear_part(): the volume term is this term's)");
+  if (!element_share.empty() && static_cast<Eigen::Index>(element_share.size()) != T_.rows())
+    throw InputError("NodalVolumeEnergy: " + std::to_string(element_share.size()) + " element shares for " +
+                     std::to_string(T_.rows()) + " tetrahedra");
   if (shear_.empty() && !material_of_.empty())
     throw InputError("NodalVolumeEnergy: a material per tetrahedron was given without the materials' shear parts to index");
   if (!shear_.empty()) material_of_ = checked_material_of(std::move(material_of_), shear_.size(), T_.rows(), "NodalVolumeEnergy");
@@ -32,13 +36,21 @@ NodalVolumeEnergy::NodalVolumeEnergy(const TetMesh& rest, const std::vector<doub
   lambda_n_ = Eigen::VectorXd::Zero(nv);
   patches_.assign(nv, {});
   tets_of_.assign(nv, {});
+  if (!element_share.empty()) kappa_ = Eigen::VectorXd::Zero(T_.rows());
   for (Eigen::Index t = 0; t < T_.rows(); ++t) {
     if (!(lambda[t] >= 0) || !std::isfinite(lambda[t]))
       throw InputError("NodalVolumeEnergy: volume stiffness of tetrahedron " + std::to_string(t) + " is not >= 0");
+    if (!element_share.empty()) {
+      if (!(element_share[t] >= 0 && element_share[t] <= lambda[t]))
+        throw InputError("NodalVolumeEnergy: element share of tetrahedron " + std::to_string(t) +
+                         " is not in [0, its volume stiffness]");
+      kappa_[t] = element_share[t];
+    }
+    const double averaged = kappa_.size() > 0 ? lambda[t] - kappa_[t] : lambda[t];
     for (int a = 0; a < 4; ++a) {
       const int n = T_(t, a);
       Vn_[n] += rest_[t].volume / 4;
-      lambda_n_[n] += rest_[t].volume / 4 * lambda[t];
+      lambda_n_[n] += rest_[t].volume / 4 * averaged;
       tets_of_[n].push_back(static_cast<int>(t));
       for (int b = 0; b < 4; ++b) patches_[n].push_back(T_(t, b));
     }
@@ -77,9 +89,10 @@ Eigen::VectorXd NodalVolumeEnergy::nodal_volume_ratios(const Points& x) const {
   return J;
 }
 
-double NodalVolumeEnergy::element_pressure(const Eigen::VectorXd& J, Eigen::Index t) const {
+double NodalVolumeEnergy::element_pressure(const Eigen::VectorXd& J, Eigen::Index t, double Jt) const {
   double s = 0;
   for (int a = 0; a < 4; ++a) s += lambda_n_[T_(t, a)] * (J[T_(t, a)] - 1) / 4;
+  if (kappa_.size() > 0) s += kappa_[t] * (Jt - 1);
   return s;
 }
 
@@ -88,6 +101,15 @@ double NodalVolumeEnergy::value(const Points& x) const {
   double e = 0;
   for (Eigen::Index n = 0; n < J.size(); ++n)
     if (Vn_[n] > 0) e += 0.5 * lambda_n_[n] * Vn_[n] * (J[n] - 1) * (J[n] - 1);
+  if (kappa_.size() > 0) {
+    double share = 0;
+#pragma omp parallel for reduction(+ : share) schedule(static)
+    for (Eigen::Index t = 0; t < T_.rows(); ++t) {
+      const double Jt = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv).determinant();
+      share += 0.5 * kappa_[t] * rest_[t].volume * (Jt - 1) * (Jt - 1);
+    }
+    e += share;
+  }
   if (!shear_.empty()) {
     double shear = 0;
 #pragma omp parallel for reduction(+ : shear) schedule(static)
@@ -108,7 +130,7 @@ void NodalVolumeEnergy::add_gradient(const Points& x, Eigen::VectorXd& g) const 
   for (Eigen::Index t = 0; t < nt; ++t) {
     const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
     const Vec9 dJ = determinant_gradient(F);
-    Mat3 P = element_pressure(J, t) * Eigen::Map<const Mat3>(dJ.data());
+    Mat3 P = element_pressure(J, t, F.determinant()) * Eigen::Map<const Mat3>(dJ.data());
     if (!shear_.empty()) P += shear_[material_of_[t]].pk1(F);
     grad_[t] = tet_gradient_from_stress(P, rest_[t].Dm_inv, rest_[t].volume);
   }
@@ -153,10 +175,13 @@ void NodalVolumeEnergy::add_hessian(const Points& x, bool project_psd, HessianAs
     const Vec9 dJ = determinant_gradient(F);
     dv[t] = tet_gradient_from_stress(Eigen::Map<const Mat3>(dJ.data()), rest_[t].Dm_inv, rest_[t].volume);
     // s d2J/dF2, or with the shear part mu I + (s - mu) d2J/dF2.
-    const double mu = shear_.empty() ? 0.0 : shear_[material_of_[t]].mu(), c = element_pressure(J, t) - mu;
+    const double mu = shear_.empty() ? 0.0 : shear_[material_of_[t]].mu(),
+                 c = element_pressure(J, t, F.determinant()) - mu;
     const Mat9 H9 = project_psd ? projected_determinant_hessian(F, c, mu)
                                 : Mat9(c * determinant_hessian(F) + mu * Mat9::Identity());
     Ke[t] = tet_hessian_from_stress_hessian(H9, rest_[t].Dm_inv, rest_[t].volume);
+    // The element share's rank-one part, kappa_t V_t dJ dJ^T = kappa_t / V_t dv dv^T (PSD).
+    if (kappa_.size() > 0) Ke[t] += kappa_[t] / rest_[t].volume * dv[t] * dv[t].transpose();
   }
   for (Eigen::Index t = 0; t < nt; ++t) tet_scatter_.add(H, t, Ke[t]);
   double* values = H.values();

@@ -218,6 +218,48 @@ TEST(NodalVolumeEnergy, WithTheShearPartItEqualsTheSplitFormAndProjectsTheSum) {
   EXPECT_LT(C.trace(), S.trace());
 }
 
+// The element-share stabilisation: a part kappa of every lambda on the element's own J (here a
+// fraction alpha). It equals the plain nodal term at (1 - alpha) lambda plus alpha times the
+// element form's volume term (the full materials' energy less their shear parts', lambda/2 (J - 1)^2 per element); it
+// matches finite differences with and without the shear part, keeps the patch test, and projects
+// to PSD.
+TEST(NodalVolumeEnergy, TheElementShareIsTheNodalTermPlusTheElementVolumeTerm) {
+  const TetMesh m = small_mesh();
+  const StableNeoHookean soft(800, 0.49), stiff(5000, 0.49);
+  std::vector<int> material_of(m.T.rows(), 0);
+  for (Eigen::Index t = 0; t < m.T.rows(); t += 3) material_of[t] = 1;
+  std::vector<double> lambda, kappa, rest_share;
+  const double alpha = 0.2;
+  for (int k : material_of) lambda.push_back((k ? stiff : soft).lambda());
+  for (double l : lambda) kappa.push_back(alpha * l), rest_share.push_back((1 - alpha) * l);
+  const NodalVolumeEnergy shared(m, lambda, {}, {}, kappa), nodal_part(m, rest_share);
+  const NodalVolumeEnergy combined(m, lambda, {soft.shear_part(), stiff.shear_part()}, material_of, kappa);
+  // alpha lambda/2 (J - 1)^2 per element: alpha times (full - shear) of the element form.
+  const ElasticEnergy full(m, {soft, stiff}, material_of), shear(m, {soft.shear_part(), stiff.shear_part()}, material_of);
+  const Points x = perturbed(m, 0.004, 31);
+  const double element_part = alpha * (full.value(x) - shear.value(x));
+  EXPECT_NEAR(shared.value(x), nodal_part.value(x) + element_part, 1e-10 * shared.value(x));
+  EXPECT_NEAR(combined.value(x), shared.value(x) + shear.value(x), 1e-10 * combined.value(x));
+  check_term(shared, m, x, shared.hessian_cliques());
+  check_term(combined, m, x, combined.hessian_cliques());
+  // Patch test: under a uniform deformation every form gives the element form's energy.
+  Mat3 A;
+  A << 1.1, 0.05, 0.0, -0.02, 0.93, 0.04, 0.01, 0.0, 1.02;
+  const Points u = (m.V * A.transpose()).eval();
+  EXPECT_NEAR(combined.value(u), full.value(u), 1e-9 * full.value(u));
+  // Partly inverted: PSD.
+  const Points y = perturbed(m, 0.02, 5);
+  ASSERT_GT(count_inverted(y, m.T), 0);
+  HessianAssembler H(static_cast<int>(m.V.rows()), m.T, {}, combined.hessian_cliques());
+  combined.add_hessian(y, true, H);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(Eigen::MatrixXd(H.matrix()));
+  EXPECT_GT(es.eigenvalues().minCoeff(), -1e-8 * es.eigenvalues().cwiseAbs().maxCoeff());
+  std::vector<double> too_much = lambda;
+  too_much[4] *= 1.01;
+  EXPECT_THROW(NodalVolumeEnergy(m, lambda, {}, {}, too_much), InputError);
+  EXPECT_THROW(NodalVolumeEnergy(m, lambda, {}, {}, std::vector<double>(3, 0.0)), InputError);
+}
+
 TEST(GravityEnergy, GradientMatchesFiniteDifferencesAndMassIsConserved) {
   const TetMesh m = small_mesh();
   const GravityEnergy e(m, 1000, Vec3(0, 0, -9.81));

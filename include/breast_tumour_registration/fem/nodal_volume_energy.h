@@ -40,8 +40,10 @@ class NodalVolumeEnergy : public EnergyTerm {
   /// shear   the materials' shear parts (StableNeoHookean::shear_part(): mu/2 (I_C - 3) - mu (J - 1)),
   ///         then part of this term; empty: not. InputError for a material with a volume term.
   /// material_of  #T indices into shear (empty: all 0; given without shear: InputError)
+  /// element_share  #T: the part kappa_t of lambda_t kept on the element's own J_t [Pa],
+  ///         0 <= kappa_t <= lambda_t (the element-share stabilisation above); empty: none.
   NodalVolumeEnergy(const TetMesh& rest, const std::vector<double>& lambda, std::vector<StableNeoHookean> shear = {},
-                    std::vector<int> material_of = {});
+                    std::vector<int> material_of = {}, const std::vector<double>& element_share = {});
 
   std::string name() const override { return shear_.empty() ? "nodal volume" : "elastic (nodal volume)"; }
   double value(const Points& x) const override;
@@ -53,8 +55,9 @@ class NodalVolumeEnergy : public EnergyTerm {
   Eigen::VectorXd nodal_volume_ratios(const Points& x) const;
 
  private:
-  /// s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 [Pa]: the tetrahedron's share of its nodes' pressures.
-  double element_pressure(const Eigen::VectorXd& Jbar, Eigen::Index t) const;
+  /// s_t = sum_{n in t} lambda_n (Jbar_n - 1) / 4 [Pa]: the tetrahedron's share of its nodes'
+  /// pressures, plus kappa_t (J_t - 1) with an element share (Jt: the element's J_t).
+  double element_pressure(const Eigen::VectorXd& Jbar, Eigen::Index t, double Jt) const;
   /// v_t = V_t J_t of every tetrahedron at x.
   Eigen::VectorXd element_volumes(const Points& x) const;
   Tetrahedra T_;
@@ -63,6 +66,7 @@ class NodalVolumeEnergy : public EnergyTerm {
   std::vector<int> material_of_;         // per tetrahedron into shear_ (with shear_)
   Eigen::VectorXd Vn_;       // rest patch volume / 4 per vertex (V_n)
   Eigen::VectorXd lambda_n_;
+  Eigen::VectorXd kappa_;  // per tetrahedron: its element share kappa_t (empty: none)
   std::vector<std::vector<int>> patches_;    // per vertex: sorted vertices of its tetrahedra (empty: none)
   std::vector<std::vector<int>> tets_of_;    // per vertex: its tetrahedra
   // Scatter maps into the assembler's values, built on first use per assembler: the element
