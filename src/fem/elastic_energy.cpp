@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/fem/elastic_energy.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -57,8 +58,11 @@ void ElasticEnergy::add_hessian(const Points& x, bool project_psd, HessianAssemb
 }
 
 void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vector<StableNeoHookean>& materials,
-                        const std::vector<int>& material_of, VolumeForm form) {
+                        const std::vector<int>& material_of, VolumeForm form, double nodal_element_share) {
   if (form == VolumeForm::Auto) throw InputError("add_elastic_energy: resolve the volume form first");
+  if (!(nodal_element_share >= 0) || !std::isfinite(nodal_element_share))
+    throw InputError("material.nodal_element_share must be a finite number >= 0 (in units of the shear modulus), not " +
+                     std::to_string(nodal_element_share));
   if (form == VolumeForm::Element) {
     energy.add(std::make_shared<ElasticEnergy>(rest, materials, material_of));
     return;
@@ -70,8 +74,9 @@ void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vec
   for (const auto& m : materials) shear.push_back(m.shear_part());
   std::vector<double> lambda(rest.T.rows());
   for (Eigen::Index t = 0; t < rest.T.rows(); ++t) lambda[t] = materials[of[t]].lambda();
-  std::vector<double> kappa(rest.T.rows());
-  for (Eigen::Index t = 0; t < rest.T.rows(); ++t) kappa[t] = std::min(kNodalElementShare * materials[of[t]].mu(), lambda[t]);
+  std::vector<double> kappa;
+  if (nodal_element_share > 0)
+    for (Eigen::Index t = 0; t < rest.T.rows(); ++t) kappa.push_back(std::min(nodal_element_share * materials[of[t]].mu(), lambda[t]));
   energy.add(std::make_shared<NodalVolumeEnergy>(rest, lambda, std::move(shear), std::move(of), kappa));
 }
 

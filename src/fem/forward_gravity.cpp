@@ -11,13 +11,15 @@ namespace btr {
 
 ForwardGravity::ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const std::vector<int>& fixed,
                                std::vector<StableNeoHookean> materials, std::vector<int> material_of,
-                               VolumeForm volume_form, double density, ForwardGravityOptions options,
+                               VolumeForm volume_form, double nodal_element_share, double density,
+                               ForwardGravityOptions options,
                                NewtonSolver* shared)
     : rest_{Points::Zero(vertices, 3), T},
       fixed_(static_cast<size_t>(vertices), false),
       materials_(std::move(materials)),
       material_of_(std::move(material_of)),
       volume_form_(volume_form),
+      nodal_element_share_(nodal_element_share),
       density_(density),
       opt_(std::move(options)) {
   if (volume_form_ == VolumeForm::Auto) throw InputError("forward gravity: resolve the volume form first");
@@ -40,7 +42,7 @@ ForwardGravity::ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const
 NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Points& x) {
   rest_.V = X;
   TotalEnergy energy;
-  add_elastic_energy(energy, rest_, materials_, material_of_, volume_form_);
+  add_elastic_energy(energy, rest_, materials_, material_of_, volume_form_, nodal_element_share_);
   auto g = std::make_shared<GravityEnergy>(rest_, density_, gravity);
   energy.add(g);
   if (!solver_) {  // the pattern does not depend on the rest positions

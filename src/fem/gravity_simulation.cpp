@@ -20,7 +20,8 @@ GravityResult solve_gravity(const GravityProblem& pb, const NewtonOptions& optio
   std::vector<StableNeoHookean> materials{StableNeoHookean(pb.youngs_modulus, pb.poisson_ratio)};
   for (double E : pb.region_youngs_modulus) materials.push_back(StableNeoHookean(E, pb.poisson_ratio));
   // ElasticEnergy checks material_of's size and range.
-  add_elastic_energy(energy, rest, materials, pb.material_of, resolve_volume_form(pb.volume_form, pb.poisson_ratio));
+  add_elastic_energy(energy, rest, materials, pb.material_of, resolve_volume_form(pb.volume_form, pb.poisson_ratio),
+                     pb.nodal_element_share);
   auto gravity = std::make_shared<GravityEnergy>(rest, pb.density, pb.gravity);
   energy.add(gravity);
   auto assembler =

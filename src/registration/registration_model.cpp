@@ -54,7 +54,8 @@ int add_tumour(RegistrationModel& model, const std::string& name, const SurfaceM
 
 
 void add_model_elastic_energy(TotalEnergy& energy, const RegistrationModel& model) {
-  add_elastic_energy(energy, model.rest, model.materials, model.material_of, model.volume_form);
+  add_elastic_energy(energy, model.rest, model.materials, model.material_of, model.volume_form,
+                     model.material.nodal_element_share);
 }
 
 void stiffen_tumours(RegistrationModel& model, double E) {

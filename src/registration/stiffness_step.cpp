@@ -150,7 +150,8 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     }
     c.rest = c.unload.rest;
     ForwardGravity phi(model.rest.T, model.prone.rows(), model.chest_wall, model.materials, model.material_of,
-                       model.volume_form, model.material.density, opt.unload.forward, shared);
+                       model.volume_form, model.material.nodal_element_share, model.material.density,
+                       opt.unload.forward, shared);
     Points x = c.rest;
     if (const auto* near = nearest_two(supine_displacements, u).first) {
       x = c.rest + std::exp(near->first - u) * near->second;

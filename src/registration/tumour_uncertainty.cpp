@@ -80,7 +80,7 @@ Eigen::VectorXd body_gradient(const RegistrationModel& m, const Points& rest, co
                               const Points& x, const Vec3& gravity) {
   TotalEnergy e;
   const TetMesh mesh{rest, m.rest.T};
-  add_elastic_energy(e, mesh, materials, m.material_of, m.volume_form);
+  add_elastic_energy(e, mesh, materials, m.material_of, m.volume_form, m.material.nodal_element_share);
   if (gravity.norm() > 0) e.add(std::make_shared<GravityEnergy>(mesh, m.material.density, gravity));
   return e.gradient(x);
 }

@@ -27,6 +27,7 @@ UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& load
   pb.materials = model.materials;
   pb.material_of = model.material_of;
   pb.volume_form = model.volume_form;
+  pb.nodal_element_share = model.material.nodal_element_share;
   pb.density = model.material.density;
   pb.gravity = gravity;
   return pb;

@@ -61,6 +61,7 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     pb.youngs_modulus = opt.youngs_modulus;
     pb.poisson_ratio = opt.poisson_ratio;
     pb.volume_form = opt.volume_form;
+    pb.nodal_element_share = opt.nodal_element_share;
     pb.density = opt.density;
     pb.gravity = g;
     pb.material_of = material_of;

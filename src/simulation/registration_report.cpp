@@ -138,6 +138,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   // Which material model ran: the volume term's form (resolved from the scene's `auto`) and
   // Poisson's ratio, which set how far the same E lets the tissue sag.
   j["material_model"] = {{"volume_form", to_string(model.volume_form)}, {"poisson_ratio", num(model.material.poisson_ratio)}};
+  if (model.volume_form == VolumeForm::Nodal)
+    j["material_model"]["nodal_element_share"] = num(model.material.nodal_element_share);
   if (r.steps.stiffness) {
     Json evaluations = Json::array();
     for (const auto& [E, misfit] : r.stiffness_evaluations)

@@ -50,6 +50,12 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   std::string volume_form = "auto";
+  double nodal_element_share = 0;
+  app.add_option("--nodal-element-share", nodal_element_share,
+                 "with the nodal volume term: the volume stiffness each tetrahedron keeps on its own volume "
+                 "change, in units of its shear modulus (material.nodal_element_share)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--volume-form", volume_form,
                  "the method's volume term: auto (element below nu = 0.495), element or nodal (no locking, slower); "
                  "the generated truth keeps its own")
@@ -96,6 +102,7 @@ int main(int argc, char** argv) {
     opt.rest_shape = rest_shape;
     opt.simulation_cell_size = simulation_cell_mm * 1e-3;
     opt.method_volume_form = parse_volume_form(volume_form);
+    opt.method_nodal_element_share = nodal_element_share;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};
     preset_options(preset);  // validates the name before the expensive steps
     const std::vector<ExperimentRun> runs = plan_experiments(opt);

@@ -90,17 +90,21 @@ TEST(Phantom, ProneHangsAndSupineFlattensWithTheChestWallFixed) {
 }
 
 TEST(Phantom, ATruthWithFoldedElementsIsRefusedWithItsCause) {
-  // The nodal volume term keeps patches, and with its element share (5 mu) most single
-  // tetrahedra, from inverting: on the coarse 12 mm phantom the share moved the softest truth it
-  // makes from 600 Pa (the plain nodal form folded one element there) to 350 Pa; at 300 Pa two
-  // elements fold in the prone sag. Before, such a truth was written and only refused later, as
-  // a prone mesh, by the registration.
-  PhantomOptions po;  // btr_phantom -E 300 --cell-size 12 --volume-form nodal
+  // The nodal volume term keeps patches, not single tetrahedra, from inverting: at 600 Pa on the
+  // coarse 12 mm phantom one element folds in the prone sag. Before, that truth was written and
+  // only refused later, as a prone mesh, by the registration.
+  PhantomOptions po;  // btr_phantom -E 600 --cell-size 12 --volume-form nodal
   po.tet.cell_size = 0.012;
   const PhantomModel model = make_phantom_model(po);
   PhantomSceneOptions so;
-  so.youngs_modulus = 300;
+  so.youngs_modulus = 600;
   so.volume_form = VolumeForm::Nodal;
+  btr::test::expect_throw_with<SolverError>([&] { simulate_phantom(model, so); }, "inverted tetrahedra under this load");
+  // With an element share of 5 mu (nodal_volume_energy.h) the same truth holds; it folds two
+  // elements from 300 Pa down, where the element form still holds.
+  so.nodal_element_share = 5;
+  EXPECT_EQ(count_inverted(simulate_phantom(model, so).prone, model.rest.T), 0);
+  so.youngs_modulus = 300;
   btr::test::expect_throw_with<SolverError>([&] { simulate_phantom(model, so); }, "inverted tetrahedra under this load");
   so.volume_form = VolumeForm::Element;
   const PhantomConfigurations c = simulate_phantom(model, so);

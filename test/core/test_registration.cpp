@@ -475,6 +475,10 @@ TEST(SceneErrors, NameTheFieldAtFault) {
   expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("preset: turbo", "bad_preset")); }, "field 'preset'");
   expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("material: {youngs_modulus: -5}", "bad_E")); }, "field 'material'");
   expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("chest_wall: nowhere.txt", "bad_wall")); }, "field 'chest_wall'");
+  expect_throw_with<InputError>(
+      [&] { load_meshed_scene(scene_with("material: {volume_form: nodal, nodal_element_share: -1}", "bad_share")); },
+      "field 'material.nodal_element_share': must be >= 0");
+  EXPECT_EQ(load_meshed_scene(scene_with("material: {volume_form: nodal, nodal_element_share: 5}", "share")).material.nodal_element_share, 5);
   btr::test::write_text(phantom_dir() + "/bad_landmarks.csv", "prone_index,supine_index\n99999,1\n");
   expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("landmarks: bad_landmarks.csv", "bad_lm")); }, "field 'landmarks'");
 }

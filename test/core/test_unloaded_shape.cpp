@@ -123,7 +123,7 @@ TEST(ForwardGravity, AFailedStepIsHalvedFromTheLoadItTried) {
   tight.newton.max_iterations = 7;
   tight.first_load_fraction = 0.6;
   tight.newton.gradient_rel_tolerance = 1e-8;
-  ForwardGravity phi(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(E, nu)}, {}, form, 1000, tight);
+  ForwardGravity phi(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(E, nu)}, {}, form, 0, 1000, tight);
   Points x = model.rest.V;
   phi.solve(model.rest.V, model.prone_gravity, x);
   const auto& steps = phi.continuation_steps();
@@ -144,7 +144,7 @@ TEST(ForwardGravity, AFailedStepIsHalvedFromTheLoadItTried) {
   EXPECT_TRUE(steps.back().second);
   ForwardGravityOptions generous = tight;
   generous.newton.max_iterations = 200;
-  ForwardGravity ref(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(E, nu)}, {}, form, 1000, generous);
+  ForwardGravity ref(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(E, nu)}, {}, form, 0, 1000, generous);
   Points xr = model.rest.V;
   ref.solve(model.rest.V, model.prone_gravity, xr);
   EXPECT_LT((x - xr).rowwise().norm().maxCoeff(), 1e-5);
@@ -176,7 +176,7 @@ TEST(ForwardGravity, ASolveThatFoldsTheMeshEndsWhenTheFoldPassesTheAllowance) {
       return true;
     };
     ForwardGravity phi(model.rest.T, model.rest.V.rows(), model.chest_wall, {StableNeoHookean(100, nu)}, {},
-                       resolve_volume_form(VolumeForm::Auto, nu), 1000, o);
+                       resolve_volume_form(VolumeForm::Auto, nu), 0, 1000, o);
     Points x = model.rest.V;
     try {
       phi.solve(model.rest.V, model.prone_gravity, x);

@@ -42,17 +42,12 @@ class ElasticEnergy : public EnergyTerm {
   mutable std::vector<Mat12> buffer_;
 };
 
-/// The nodal form's element share (nodal_volume_energy.h): every tetrahedron keeps a volume
-/// stiffness kNodalElementShare * mu of its own (at most its lambda), the rest on nodal averages.
-/// Measured on the suite (BENCHMARKS.md, "The nodal form with an element share"): 5 against 2
-/// and 0 on two independent bodies at fat 300 to 1000 Pa; as a multiple of mu it does not lock
-/// as nu -> 0.5 (the cantilever's error stays within 36 % of beam theory at nu = 0.4999).
-constexpr double kNodalElementShare = 5;
-
 /// Adds the stable Neo-Hookean energy of the materials to `energy`: one ElasticEnergy (Element
-/// form), or one NodalVolumeEnergy with their shear parts and the element share above (Nodal
-/// form). `form` must be resolved (not Auto). material_of as for ElasticEnergy.
+/// form), or one NodalVolumeEnergy with their shear parts (Nodal form), each tetrahedron keeping
+/// min(nodal_element_share mu, lambda) of its volume stiffness on its own J
+/// (MaterialParameters::nodal_element_share; InputError below 0). `form` must be resolved (not
+/// Auto). material_of as for ElasticEnergy.
 void add_elastic_energy(TotalEnergy& energy, const TetMesh& rest, const std::vector<StableNeoHookean>& materials,
-                        const std::vector<int>& material_of, VolumeForm form);
+                        const std::vector<int>& material_of, VolumeForm form, double nodal_element_share);
 
 }  // namespace btr

@@ -47,7 +47,8 @@ class ForwardGravity {
   /// the solves are those of a new solver. Null: one is built on the first solve.
   ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const std::vector<int>& fixed,
                  std::vector<StableNeoHookean> materials, std::vector<int> material_of, VolumeForm volume_form,
-                 double density, ForwardGravityOptions options = {}, NewtonSolver* shared = nullptr);
+                 double nodal_element_share, double density, ForwardGravityOptions options = {},
+                 NewtonSolver* shared = nullptr);
 
   /// The equilibrium of rest shape X under `gravity` [m/s^2] with the fixed vertices at X's
   /// positions; x is the start and receives the equilibrium. Returns the Newton iterations it
@@ -68,6 +69,7 @@ class ForwardGravity {
   std::vector<StableNeoHookean> materials_;
   std::vector<int> material_of_;
   VolumeForm volume_form_;
+  double nodal_element_share_;
   double density_;
   ForwardGravityOptions opt_;
   std::unique_ptr<NewtonSolver> own_;

@@ -23,6 +23,7 @@ struct GravityProblem {
   std::vector<int> material_of;
   std::vector<double> region_youngs_modulus;  ///< [Pa]
   VolumeForm volume_form = VolumeForm::Auto;  ///< see elastic_energy.h
+  double nodal_element_share = 0;             ///< MaterialParameters::nodal_element_share
 };
 
 struct GravityResult {

@@ -11,6 +11,11 @@ struct MaterialParameters {
   double poisson_ratio = 0.49;
   double density = 1000;         ///< [kg/m^3]
   VolumeForm volume_form = VolumeForm::Auto;  ///< element or nodal volume term (elastic_energy.h)
+  /// With the nodal volume term: the volume stiffness every tetrahedron keeps on its own J, in
+  /// units of its mu (at most its lambda; nodal_volume_energy.h). 0: the plain nodal form. A
+  /// trade (BENCHMARKS.md, "The nodal form with an element share"): 5 converges more of the
+  /// suite's soft runs and costs 0.1 to 0.2 mm at fat 1000 Pa.
+  double nodal_element_share = 0;
 };
 
 }  // namespace btr

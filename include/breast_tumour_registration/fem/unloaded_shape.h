@@ -62,6 +62,7 @@ struct UnloadProblem {
   std::vector<StableNeoHookean> materials;
   std::vector<int> material_of;     ///< per tetrahedron (empty: all materials[0])
   VolumeForm volume_form = VolumeForm::Element;  ///< resolved (not Auto)
+  double nodal_element_share = 0;   ///< MaterialParameters::nodal_element_share
   double density = 1000;            ///< [kg/m^3]
   Vec3 gravity = Vec3(0, 0, 9.81);  ///< [m/s^2] the gravity the loaded shape was imaged under
   /// A first estimate of the rest shape (e.g. the unloaded shape of a nearby stiffness): the

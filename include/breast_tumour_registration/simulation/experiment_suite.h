@@ -54,6 +54,7 @@ struct ExperimentSuiteOptions {
   int shard = 1, shards = 1;
   /// The method's volume term (the generating material keeps its own: simulate_phantom).
   VolumeForm method_volume_form = VolumeForm::Auto;
+  double method_nodal_element_share = 0;  ///< the method's MaterialParameters::nodal_element_share
   /// > 0 [m]: every run's prone model is re-tetrahedralized from its boundary at this size
   /// (with_simulation_mesh), as btr_register meshes a prone surface; 0: the model's own mesh
   /// (with given configurations, the mesh their truth was computed on).

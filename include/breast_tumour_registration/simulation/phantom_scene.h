@@ -22,6 +22,7 @@ struct PhantomSceneOptions {
   double poisson_ratio = 0.49;
   double density = 1000;
   VolumeForm volume_form = VolumeForm::Auto;  ///< of the generating material (elastic_energy.h)
+  double nodal_element_share = 0;  ///< with the nodal form (MaterialParameters::nodal_element_share)
   LengthUnit units = LengthUnit::Millimetre;
   std::string landmark_set = "C+O";
   /// > 0: the tumours' elements get this Young's modulus when generating prone and supine
