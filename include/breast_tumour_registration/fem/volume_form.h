@@ -19,7 +19,8 @@ enum class VolumeForm { Auto, Element, Nodal };
 /// three bodies (9 to 24 of 28 runs not converged at fat 300 to 500 Pa, 0 to 4 with the element
 /// form), although from 1000 Pa up and with the full method it is the nearer model on both
 /// independent bodies. `material.volume_form: nodal` chooses it at any nu (BENCHMARKS.md, "The
-/// nodal volume term's cost").
+/// nodal volume term's cost"); `material.nodal_element_share` converges some of those folding
+/// runs at a cost in accuracy (BENCHMARKS.md, "The nodal form with an element share").
 constexpr double kNodalVolumeFromPoisson = 0.495;
 VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio);
 /// Parses "auto", "element" or "nodal"; InputError otherwise.
