@@ -35,7 +35,8 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   }
   const Points& xp = loaded.V;
 
-  ForwardGravity phi(loaded.T, nv, pb.fixed, pb.materials, pb.material_of, pb.volume_form, pb.nodal_element_share, pb.density, opt.forward, pb.solver);
+  ForwardGravity phi(loaded.T, nv, pb.fixed, pb.materials, pb.material_of, pb.volume_form, pb.nodal_element_share,
+                     pb.density, opt.forward, pb.solver);
   UnloadResult res;
   int first = 0;  // Newton iterations of the first converged forward solve: the cost unit
   // phi(X) under gravity g; x the start, then the equilibrium. false: it failed (x unchanged).

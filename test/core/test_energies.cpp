@@ -220,9 +220,9 @@ TEST(NodalVolumeEnergy, WithTheShearPartItEqualsTheSplitFormAndProjectsTheSum) {
 
 // The element-share stabilisation: a part kappa of every lambda on the element's own J (here a
 // fraction alpha). It equals the plain nodal term at (1 - alpha) lambda plus alpha times the
-// element form's volume term (the full materials' energy less their shear parts', lambda/2 (J - 1)^2 per element); it
-// matches finite differences with and without the shear part, keeps the patch test, and projects
-// to PSD.
+// element form's volume term (the full materials' energy less their shear parts': lambda/2
+// (J - 1)^2 per element); it matches finite differences with and without the shear part, keeps
+// the patch test, and projects to PSD.
 TEST(NodalVolumeEnergy, TheElementShareIsTheNodalTermPlusTheElementVolumeTerm) {
   const TetMesh m = small_mesh();
   const StableNeoHookean soft(800, 0.49), stiff(5000, 0.49);
