@@ -11,6 +11,7 @@
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/validation.h"
+#include "breast_tumour_registration/registration/fold_advice.h"
 #include "breast_tumour_registration/registration/material_regions.h"
 #include "breast_tumour_registration/registration/registration_step.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
@@ -220,6 +221,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       r.warnings.push_back(rep.name + " step: " + std::to_string(rep.inverted) + " tetrahedra ended inverted" +
                            (rep.inversions_allowed ? " (the line search stalled on the inversion rule and was let invert)" : ""));
   }
+  if (const std::string advice = fold_advice(model, r.reports); !advice.empty()) r.warnings.push_back(advice);
   r.seconds = since(t_start);
 
   // Outputs in the supine frame and figures of merit.

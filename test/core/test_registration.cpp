@@ -18,6 +18,7 @@
 #include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/io/index_io.h"
 #include "breast_tumour_registration/io/mesh_io.h"
+#include "breast_tumour_registration/registration/fold_advice.h"
 #include "breast_tumour_registration/registration/icp_alignment.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/registration/stiffness_grid_walk.h"
@@ -461,6 +462,30 @@ TEST(Unload, InThePipelineItBeatsTheProneShapeAsRestOnASoftBreast) {
       EXPECT_LT(worst_error(unloaded), 0.3 * worst_error(prone));
     }
   }
+}
+
+// A registration with the nodal volume term that ends not converged because the mesh folded
+// says what holds such meshes together (the measured alternatives); nothing otherwise.
+TEST(FoldAdvice, NamesTheMeasuredAlternativesOnlyForANodalFold) {
+  RegistrationModel model;
+  model.volume_form = VolumeForm::Nodal;
+  StepReport fine, folded, capped;
+  fine.name = folded.name = capped.name = "surface";
+  fine.converged = true;
+  folded.stop_reason = "the skin settled, but 40 tetrahedra ended inverted (40 new, beyond the allowance of 14): the mesh folded";
+  capped.stop_reason = "projection cap (150) reached";
+  EXPECT_EQ(fold_advice(model, {fine}), "");
+  EXPECT_EQ(fold_advice(model, {capped}), "");
+  EXPECT_NE(fold_advice(model, {fine, folded}).find("material.nodal_element_share: 5"), std::string::npos);
+  StepReport inverted_landmarks;  // Newton's own fold stop keeps the last uninverted state (none inverted)
+  inverted_landmarks.stop_reason = "stalled: every step inverted an element, and letting them invert folded the mesh";
+  EXPECT_NE(fold_advice(model, {inverted_landmarks}).find("nodal_element_share"), std::string::npos);
+  model.material.nodal_element_share = 5;
+  const std::string with_share = fold_advice(model, {folded});
+  EXPECT_NE(with_share.find("volume_form: element"), std::string::npos);
+  EXPECT_EQ(with_share.find("nodal_element_share: 5"), std::string::npos);
+  model.volume_form = VolumeForm::Element;
+  EXPECT_EQ(fold_advice(model, {folded}), "");
 }
 
 TEST(SceneErrors, NameTheFieldAtFault) {
