@@ -52,6 +52,12 @@ int main(int argc, char** argv) {
   app.add_option("--volume-form", volume_form, "volume term of the generating material: auto, element or nodal "
                                                "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
       ->capture_default_str();
+  double nodal_element_share = 0;
+  app.add_option("--nodal-element-share", nodal_element_share,
+                 "with the nodal volume term: the volume stiffness each tetrahedron keeps on its own volume change, "
+                 "in units of its shear modulus (material.nodal_element_share)")
+      ->capture_default_str()
+      ->check(btr::cli::non_negative());
   std::string label_dir;
   std::vector<double> voxel_mm = {1.0};
   std::vector<int> min_voxels;
@@ -78,6 +84,7 @@ int main(int argc, char** argv) {
     o.youngs_modulus = E;
     o.poisson_ratio = nu;
     o.volume_form = parse_volume_form(volume_form);
+    o.nodal_element_share = nodal_element_share;
     o.density = rho;
     o.phantom.tet.cell_size = cell_mm * 1e-3;
     o.phantom.tet.radius_edge_ratio = ratio;
