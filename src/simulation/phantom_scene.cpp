@@ -192,9 +192,9 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   scene["preset"] = "balanced";
   scene["generator"]["youngs_modulus"] = opt.youngs_modulus;
   scene["generator"]["poisson_ratio"] = opt.poisson_ratio;
-  scene["generator"]["volume_form"] = to_string(resolve_volume_form(opt.volume_form, opt.poisson_ratio));
-  if (resolve_volume_form(opt.volume_form, opt.poisson_ratio) == VolumeForm::Nodal)
-    scene["generator"]["nodal_element_share"] = opt.nodal_element_share;
+  const VolumeForm generating_form = resolve_volume_form(opt.volume_form, opt.poisson_ratio);
+  scene["generator"]["volume_form"] = to_string(generating_form);
+  if (generating_form == VolumeForm::Nodal) scene["generator"]["nodal_element_share"] = opt.nodal_element_share;
   scene["generator"]["density"] = opt.density;
   scene["generator"]["tumour_youngs_modulus"] = opt.tumour_youngs_modulus;
   scene["generator"]["gland_youngs_modulus"] = opt.gland_youngs_modulus;

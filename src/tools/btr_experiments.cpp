@@ -50,16 +50,16 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   std::string volume_form = "auto";
+  app.add_option("--volume-form", volume_form,
+                 "the method's volume term: auto (element below nu = 0.495), element or nodal (no locking, slower); "
+                 "the generated truth keeps its own")
+      ->check(CLI::IsMember({"auto", "element", "nodal"}))
+      ->capture_default_str();
   double nodal_element_share = 0;
   app.add_option("--nodal-element-share", nodal_element_share,
                  "with the nodal volume term: the volume stiffness each tetrahedron keeps on its own volume "
                  "change, in units of its shear modulus (material.nodal_element_share)")
       ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--volume-form", volume_form,
-                 "the method's volume term: auto (element below nu = 0.495), element or nodal (no locking, slower); "
-                 "the generated truth keeps its own")
-      ->check(CLI::IsMember({"auto", "element", "nodal"}))
       ->capture_default_str();
   app.add_option("--cell-size", cell_mm, "built-in phantom: tetrahedron size bound [mm] (8: ~6k tets, 4.7: ~35k)")
       ->capture_default_str();
