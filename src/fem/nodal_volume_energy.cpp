@@ -101,21 +101,21 @@ double NodalVolumeEnergy::value(const Points& x) const {
   double e = 0;
   for (Eigen::Index n = 0; n < J.size(); ++n)
     if (Vn_[n] > 0) e += 0.5 * lambda_n_[n] * Vn_[n] * (J[n] - 1) * (J[n] - 1);
-  if (kappa_.size() > 0) {
-    double share = 0;
-#pragma omp parallel for reduction(+ : share) schedule(static)
+  // The per-element parts (the element share and the shear part), on one F per tetrahedron.
+  const bool share = kappa_.size() > 0, shear = !shear_.empty();
+  if (share || shear) {
+    double per_element = 0;
+#pragma omp parallel for reduction(+ : per_element) schedule(static)
     for (Eigen::Index t = 0; t < T_.rows(); ++t) {
-      const double Jt = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv).determinant();
-      share += 0.5 * kappa_[t] * rest_[t].volume * (Jt - 1) * (Jt - 1);
+      const Mat3 F = deformation_gradient(x, T_.row(t), rest_[t].Dm_inv);
+      double psi = shear ? shear_[material_of_[t]].psi(F) : 0.0;
+      if (share) {
+        const double dJ = F.determinant() - 1;
+        psi += 0.5 * kappa_[t] * dJ * dJ;
+      }
+      per_element += rest_[t].volume * psi;
     }
-    e += share;
-  }
-  if (!shear_.empty()) {
-    double shear = 0;
-#pragma omp parallel for reduction(+ : shear) schedule(static)
-    for (Eigen::Index t = 0; t < T_.rows(); ++t)
-      shear += rest_[t].volume * shear_[material_of_[t]].psi(deformation_gradient(x, T_.row(t), rest_[t].Dm_inv));
-    e += shear;
+    e += per_element;
   }
   return e;
 }
