@@ -294,8 +294,19 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       // An estimated E follows a Poisson's ratio other than the method's (the landmarks it was fitted on).
       std::optional<LandmarkStiffnessFit> fit;
       if (r.stiffness_prediction.rows() > 0) fit = LandmarkStiffnessFit{scene.landmark_anchors, r.stiffness_prediction};
+      // A pose solved with the deformation stays free in the linearisation, and the landmarks
+      // that share it (SurfaceGuidedStep: 3 or more) are a source.
+      std::optional<FreePoseLinearisation> free_pose;
+      if (r.pose_solved_with_surface) {
+        free_pose = FreePoseLinearisation{to_projector, {}, Points(0, 3), opt.surface.pose_points_weight};
+        if (targets.rows() >= 3) {
+          free_pose->landmarks = scene.landmark_anchors;
+          free_pose->landmark_targets = transform_points(to_projector, targets);
+        }
+      }
       const UncertaintyResult u = linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed,
-                                                                uopt, pose_covariance, fit ? &*fit : nullptr);
+                                                                uopt, pose_covariance, fit ? &*fit : nullptr,
+                                                                free_pose ? &*free_pose : nullptr);
       for (size_t i = 0; i < r.tumours.size(); ++i) r.tumours[i].uncertainty = u.tumours[i];
       r.uncertainty_seconds = u.seconds;
       if (u.estimate_follows_poisson_ratio) {
@@ -312,9 +323,18 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       }
       if (!u.note.empty()) notes.push_back(u.note);
       if (r.pose_solved_with_surface)
-        notes.push_back("the rigid pose is held at its solution, but here it is solved with the deformation: on such a "
-                        "body (no rigid region) the linear region came out 3 to 5 times smaller than sampled "
-                        "re-registrations; use --uncertainty sampling");
+        notes.push_back(free_pose->landmarks.empty()
+                            ? "the rigid pose is solved with the deformation and linearised free"
+                            : "the rigid pose is solved with the deformation and linearised free; the landmarks that "
+                              "share it are a source");
+      if (u.estimate_follows_landmarks) {
+        char b[220];
+        std::snprintf(b, sizeof b,
+                      "the estimated E moves with the landmarks, jointly with their direct effect (sd of ln E from "
+                      "their noise %.3g; %.3g left as an independent source)",
+                      u.log_sd_from_landmarks, u.log_sd_independent);
+        notes.push_back(b);
+      }
       if (!r.converged) notes.push_back("linearised at a state that is not converged");
       for (const auto& n : notes) r.uncertainty_note += (r.uncertainty_note.empty() ? "" : "; ") + n;
     }

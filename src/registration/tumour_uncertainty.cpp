@@ -2,6 +2,7 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <algorithm>
 #include <chrono>
@@ -15,6 +16,8 @@
 #include "breast_tumour_registration/fem/gmres.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
+#include "breast_tumour_registration/fem/rigid_free_surface_energy.h"
+#include "breast_tumour_registration/fem/small_matrices.h"
 #include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
@@ -159,13 +162,17 @@ bool fit_usable(const LandmarkStiffnessFit& fit, int nv) {
   return fit.anchors.size() >= 3 && fit.supine_prediction.rows() == nv && fit.supine_prediction.allFinite();
 }
 
-/// d ln E / d q of the stiffness step's landmark fit (LandmarkStiffnessFit): the supine
-/// gravity-only prediction's response to ln E and to q (the rest shape's part included: dX_rest,
-/// empty when the rest shape is the prone one), its landmarks' motion, the part of it no rigid
-/// motion of the landmarks explains (the fit re-fits the pose: Kabsch), and the Gauss-Newton
-/// step of ln E that fits them again.
-double per_compliance(const RegistrationModel& m, const TotalEnergy& elastic, const LandmarkStiffnessFit& fit,
-                      const std::vector<Eigen::VectorXd>& dX_rest) {
+/// The stiffness step's landmark fit (LandmarkStiffnessFit) linearised: how its landmarks move
+/// per unit ln E and per unit q (with_q; else zero) in the supine gravity-only prediction (the
+/// rest shape's part included: dX_rest, empty when the rest shape is the prone one), less the
+/// part any rigid motion of the landmarks explains (the fit re-fits the pose: Kabsch). Model
+/// frame, 3 rows per landmark.
+struct LandmarkFitMotion {
+  Eigen::VectorXd per_log_e, per_q;
+};
+
+LandmarkFitMotion landmark_fit_motion(const RegistrationModel& m, const TotalEnergy& elastic, const LandmarkStiffnessFit& fit,
+                                      const std::vector<Eigen::VectorXd>& dX_rest, bool with_q) {
   const int nv = static_cast<int>(m.rest.V.rows());
   const Points& xg = fit.supine_prediction;
   HessianAssembler Hg(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
@@ -181,8 +188,9 @@ double per_compliance(const RegistrationModel& m, const TotalEnergy& elastic, co
     for (int i = 0; i < n; ++i) l.segment<3>(3 * i) = fit.anchors[i].position(d);
     return l;
   };
-  Eigen::VectorXd l_E = landmark_motion(elastic.gradient(xg), 0);
-  Eigen::VectorXd l_q = landmark_motion(elastic_gradient_d_compliance(m, xg), 1);
+  LandmarkFitMotion out;
+  out.per_log_e = landmark_motion(elastic.gradient(xg), 0);
+  out.per_q = with_q ? landmark_motion(elastic_gradient_d_compliance(m, xg), 1) : Eigen::VectorXd::Zero(3 * n);
   // The landmarks' small rigid motions about their centroid: translations, and e_k x (p - c).
   Eigen::MatrixXd B(3 * n, 6);
   Vec3 c = Vec3::Zero();
@@ -193,10 +201,15 @@ double per_compliance(const RegistrationModel& m, const TotalEnergy& elastic, co
     for (int k = 0; k < 3; ++k) B.block<3, 1>(3 * i, 3 + k) = Vec3::Unit(k).cross(r);
   }
   const Eigen::MatrixXd Q = Eigen::HouseholderQR<Eigen::MatrixXd>(B).householderQ() * Eigen::MatrixXd::Identity(3 * n, 6);
-  l_E -= Q * (Q.transpose() * l_E);
-  l_q -= Q * (Q.transpose() * l_q);
-  if (!(l_E.squaredNorm() > 0)) return 0;
-  return -l_E.dot(l_q) / l_E.squaredNorm();
+  out.per_log_e -= Q * (Q.transpose() * out.per_log_e);
+  out.per_q -= Q * (Q.transpose() * out.per_q);
+  return out;
+}
+
+/// d ln E / d q of the fit: the Gauss-Newton step of ln E that fits the moved landmarks again.
+double per_compliance(const LandmarkFitMotion& f) {
+  if (!(f.per_log_e.squaredNorm() > 0)) return 0;
+  return -f.per_log_e.dot(f.per_q) / f.per_log_e.squaredNorm();
 }
 
 }  // namespace
@@ -225,7 +238,7 @@ double log_youngs_modulus_per_compliance(const RegistrationModel& model, const L
   std::vector<Eigen::VectorXd> dX_rest;
   if (model.unloaded_under.norm() > 0)
     dX_rest = rest_response_to_material(model, elastic, true).dX;
-  return per_compliance(model, elastic, fit, dX_rest);
+  return per_compliance(landmark_fit_motion(model, elastic, fit, dX_rest, true));
 }
 
 void validate_uncertainty_options(const UncertaintyOptions& o) {
@@ -270,7 +283,8 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
                                                 const UncertaintyOptions& opt, const std::optional<Mat6>& pose_covariance,
-                                                const LandmarkStiffnessFit* stiffness_fit) {
+                                                const LandmarkStiffnessFit* stiffness_fit,
+                                                const FreePoseLinearisation* free_pose) {
   std::vector<HeldSkinVertex> held;
   const Mat3 R_p = model_to_projector.linear();
   const Rigid to_model = model_to_projector.inverse();
@@ -279,18 +293,25 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     if (!holds_projection(c, surface)) continue;
     held.push_back({v, to_model * c.point, (R_p.transpose() * c.normal).normalized()});
   }
-  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt, pose_covariance, stiffness_fit);
+  return linearised_tumour_uncertainty(model, x, held, model_to_supine, surface, opt, pose_covariance, stiffness_fit,
+                                       free_pose);
 }
 
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
                                                 const SurfaceStepOptions& surface, const UncertaintyOptions& opt,
                                                 const std::optional<Mat6>& pose_covariance,
-                                                const LandmarkStiffnessFit* stiffness_fit) {
+                                                const LandmarkStiffnessFit* stiffness_fit,
+                                                const FreePoseLinearisation* free_pose) {
   validate_uncertainty_options(opt);
   const auto t0 = std::chrono::steady_clock::now();
   UncertaintyResult out;
   const int nv = static_cast<int>(x.rows());
+  if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
+  if (free_pose && pose_covariance)
+    throw InputError("uncertainty: a pose solved with the deformation is not an input with a covariance");
+  if (free_pose && static_cast<Eigen::Index>(free_pose->landmarks.size()) != free_pose->landmark_targets.rows())
+    throw InputError("uncertainty: the landmarks sharing the pose and their targets differ in number");
 
   // The fixed point's Jacobian: elastic + held skin along its normals.
   TotalEnergy elastic;
@@ -303,13 +324,42 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // direction, with both springs' weight.
   const bool held_along = opt.held_projections || surface.sliding == SkinSliding::HeldWhereSettled;
   const double w_point = held_along ? surface.point_weight : 0, w_plane = held_along ? surface.plane_weight : spring;
-  auto springs = std::make_shared<SpringEnergy>("held skin");
-  for (const HeldSkinVertex& h : held)
-    springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, w_point, w_plane);
-  if (held.empty()) throw InputError("uncertainty: no skin vertex is held by the supine surface");
   TotalEnergy jac;
   for (const auto& t : elastic.terms()) jac.add(t);
-  jac.add(springs);
+  // With the pose free the held springs are those of RigidFreeSurfaceEnergy, in the projector's
+  // frame, the landmarks sharing the pose; Q is the rotation of the pose at x (model ->
+  // projector) and cbar the centroid of the correspondences there, about which it turns.
+  Mat3 Q = Mat3::Identity();
+  Vec3 cbar = Vec3::Zero();
+  Rigid P = Rigid::Identity();
+  std::vector<Anchor> pose_anchors;  // the landmarks', with a free pose
+  if (free_pose) {
+    auto fs = std::make_shared<RigidFreeSurfaceEnergy>(w_point, w_plane);
+    const Rigid& P0 = free_pose->model_to_projector;
+    Points y(static_cast<Eigen::Index>(held.size()), 3), n(static_cast<Eigen::Index>(held.size()), 3);
+    std::vector<int> verts;
+    for (size_t k = 0; k < held.size(); ++k) {
+      y.row(static_cast<Eigen::Index>(k)) = (P0 * held[k].point).transpose();
+      n.row(static_cast<Eigen::Index>(k)) = (P0.linear() * held[k].normal).transpose();
+      verts.push_back(held[k].vertex);
+    }
+    fs->set(verts, y, n);
+    if (free_pose->landmark_targets.rows() > 0) {
+      fs->set_points(free_pose->landmarks, free_pose->landmark_targets, free_pose->landmark_weight);
+      pose_anchors = free_pose->landmarks;
+    }
+    P = fs->pose(x);
+    Q = P.linear();
+    for (const HeldSkinVertex& h : held) cbar += P * Vec3(x.row(h.vertex).transpose());
+    for (const Anchor& a : pose_anchors) cbar += P * a.position(x);
+    cbar /= static_cast<double>(held.size() + pose_anchors.size());
+    jac.add(fs);
+  } else {
+    auto springs = std::make_shared<SpringEnergy>("held skin");
+    for (const HeldSkinVertex& h : held)
+      springs->add_point_and_plane(Anchor::vertex(h.vertex), h.point, h.normal, w_point, w_plane);
+    jac.add(springs);
+  }
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
   use_single_threaded_blas();
   keep_freed_heap_memory();
@@ -318,13 +368,33 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // projected one is a bound on the stiffness, so the spread it gives is a lower bound.
   if (factorize_exact_or_projected(jac, x, H, llt, "the fixed point's Jacobian"))
     out.note = "the exact Hessian is not positive definite at the result; linearised on the projected one (a lower bound)";
+  // The pose's rank-6 part (H - W M W^T, free DOFs), by the Woodbury identity as the Newton
+  // solver applies it; empty with a held pose.
+  const LowRankHessian low = jac.low_rank_hessian(x, H);
+  Eigen::MatrixXd Z;
+  Eigen::FullPivLU<Eigen::MatrixXd> K;
+  if (low.W.cols()) {
+    Z = llt.solve(low.W);
+    K.compute(Eigen::MatrixXd::Identity(low.M.rows(), low.M.rows()) - low.M * (low.W.transpose() * Z));
+  }
+  auto solve = [&](const Eigen::MatrixXd& rhs) {
+    Eigen::MatrixXd d = llt.solve(rhs);
+    if (low.W.cols()) d += Z * K.solve(low.M * (Z.transpose() * rhs));
+    return d;
+  };
+  // The pose's motion xi = (omega about cbar, tau) per correspondence: d(P p) = J xi.
+  auto pose_jacobian = [&](const Vec3& p_projector) {
+    Eigen::Matrix<double, 3, 6> J;
+    J << -cross_matrix(p_projector - cbar), Mat3::Identity();
+    return J;
+  };
 
   // Inputs' dG/dp on the free DOFs. G_elastic is linear in E: dG/d ln E = G_elastic. Poisson's
   // ratio enters through the volume compliance q = (1 - 2 nu) / (2 nu), in which the response
   // is near linear (the volume stiffness is ~ mu / q), unlike in nu itself near 0.5.
-  const double sd_log_e = !opt.sources.samples_youngs_modulus() ? 0.0
-                          : opt.youngs_modulus_log_sd > 0    ? opt.youngs_modulus_log_sd
-                                                             : opt.sources.youngs_modulus_log_sd();
+  double sd_log_e = !opt.sources.samples_youngs_modulus() ? 0.0
+                    : opt.youngs_modulus_log_sd > 0    ? opt.youngs_modulus_log_sd
+                                                       : opt.sources.youngs_modulus_log_sd();
   const double sd_q = volume_compliance_rms(opt.sources.poisson_ratio_range, model.material.poisson_ratio);
   Eigen::VectorXd full_E = elastic.gradient(x);
   Eigen::VectorXd full_q = sd_q > 0 ? elastic_gradient_d_compliance(model, x) : Eigen::VectorXd::Zero(3 * nv);
@@ -348,11 +418,32 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       out.note += (out.note.empty() ? "" : "; ") + std::string(b);
     }
   }
-  // E estimated from the landmarks follows a true nu other than the method's.
-  if (stiffness_fit && sd_q > 0 && fit_usable(*stiffness_fit, nv)) {
-    out.log_youngs_modulus_per_compliance = per_compliance(model, elastic, *stiffness_fit, dX_rest);
+  // The landmark fit an estimated E came from: it follows a true nu other than the method's,
+  // and (with a free pose) the landmarks that also hold the skin.
+  const double sd_landmark = opt.sources.landmark_sd;
+  const bool landmarks_source = free_pose && !pose_anchors.empty() && sd_landmark > 0;
+  const bool fit_given = stiffness_fit && fit_usable(*stiffness_fit, nv);
+  // The estimate's sd is the landmarks' (StiffnessEstimate::log_sd) when it was fitted on them:
+  // with the landmarks a source, that part moves with them, jointly.
+  const bool estimate_follows_landmarks = landmarks_source && fit_given && opt.youngs_modulus_log_sd > 0 &&
+                                          stiffness_fit->anchors.size() == pose_anchors.size();
+  LandmarkFitMotion fit_motion;
+  if (fit_given && (sd_q > 0 || estimate_follows_landmarks))
+    fit_motion = landmark_fit_motion(model, elastic, *stiffness_fit, dX_rest, sd_q > 0);
+  if (fit_given && sd_q > 0) {
+    out.log_youngs_modulus_per_compliance = per_compliance(fit_motion);
     out.estimate_follows_poisson_ratio = true;
     full_q += out.log_youngs_modulus_per_compliance * full_E;
+  }
+  if (estimate_follows_landmarks && fit_motion.per_log_e.squaredNorm() > 0) {
+    // Gauss-Newton: d ln E / dy = l_E / |l_E|^2 per landmark coordinate (model frame); what of
+    // the estimate's sd the landmarks' noise explains moves with them, the rest (a misfit above
+    // the noise) stays an independent source.
+    const double sd_from_landmarks = sd_landmark / fit_motion.per_log_e.norm();
+    sd_log_e = std::sqrt(std::max(0.0, sd_log_e * sd_log_e - sd_from_landmarks * sd_from_landmarks));
+    out.estimate_follows_landmarks = true;
+    out.log_sd_from_landmarks = sd_from_landmarks;
+    out.log_sd_independent = sd_log_e;
   }
   const Eigen::VectorXd b_E = H.gather(full_E), b_q = H.gather(full_q);
   Eigen::VectorXd b_g[2];
@@ -372,19 +463,23 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   // springs' force w_point r + w_plane n (n . r) changes by
   //   -(w_point dp + w_plane n (n . dp)) + w_plane (dn (n . r) + n (dn . r)).
   Eigen::VectorXd b_pose[6];
-  for (int k = 0; k < 6; ++k) {
-    Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
-    const Vec3 e = Vec3::Unit(k % 3);
-    for (const HeldSkinVertex& h : held) {
-      const Vec3 dp = k < 3 ? Vec3(e.cross(h.point)) : e;
-      const Vec3 dn = k < 3 ? Vec3(e.cross(h.normal)) : Vec3::Zero();
-      const Vec3 r = x.row(h.vertex).transpose() - h.point;
-      full.segment<3>(3 * h.vertex) +=
-          -(w_point * dp + w_plane * h.normal * h.normal.dot(dp)) + w_plane * (dn * h.normal.dot(r) + h.normal * dn.dot(r));
+  if (!free_pose)
+    for (int k = 0; k < 6; ++k) {
+      Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
+      const Vec3 e = Vec3::Unit(k % 3);
+      for (const HeldSkinVertex& h : held) {
+        const Vec3 dp = k < 3 ? Vec3(e.cross(h.point)) : e;
+        const Vec3 dn = k < 3 ? Vec3(e.cross(h.normal)) : Vec3::Zero();
+        const Vec3 r = x.row(h.vertex).transpose() - h.point;
+        full.segment<3>(3 * h.vertex) +=
+            -(w_point * dp + w_plane * h.normal * h.normal.dot(dp)) + w_plane * (dn * h.normal.dot(r) + h.normal * dn.dot(r));
+      }
+      b_pose[k] = H.gather(full);
     }
-    b_pose[k] = H.gather(full);
-  }
   const Mat3 R_s = model_to_supine.linear();
+  // Out to the supine frame: from the model frame with a held pose; with a free one from the
+  // projector's frame (model_to_supine = S P, S fixed), the centroid moving with x and with P.
+  const Mat3 R_out = free_pose ? Mat3(R_s * free_pose->model_to_projector.linear().transpose()) : R_s;
   const double sd_theta = opt.sources.gravity_direction_deg * M_PI / 180.0;
   for (const auto& mt : model.tumours) {
     const SurfaceMesh s{apply_embedding(mt.embedding, model.rest.T, x), mt.prone.F};
@@ -395,40 +490,83 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       for (int k = 0; k < 4; ++k)
         Jx.middleRows<3>(3 * model.rest.T(t, k)) += mt.embedding.weights(p, k) * Jp.middleCols<3>(3 * p).transpose();
     }
-    Eigen::MatrixXd R(H.num_free_dofs(), 3);
-    for (int k = 0; k < 3; ++k) R.col(k) = H.gather(Jx.col(k));
-    const Eigen::MatrixXd lambda = llt.solve(R);  // free DOFs x 3
+    const Vec3 c_m = volume_centroid(s);
+    // The output's adjoint: dc_out = L^T dx (+ the pose's direct response to moved targets).
+    // Held pose: L = dc/dx. Free pose: d(P c) = Q dc + Jc xi with xi = -M W^T dx + M sum J^T A dy.
+    Eigen::MatrixXd L(H.num_free_dofs(), 3);
+    for (int k = 0; k < 3; ++k) L.col(k) = H.gather(Jx.col(k));
+    Eigen::Matrix<double, 3, 6> Jc = Eigen::Matrix<double, 3, 6>::Zero();
+    if (free_pose) {
+      Jc = pose_jacobian(P * c_m);
+      L = Eigen::MatrixXd(L * Q.transpose()) - low.W * (low.M * Jc.transpose());
+    }
+    const Eigen::MatrixXd lambda = solve(L);  // free DOFs x 3
+    // A target y_j moved by dy (projector frame) with metric A_j: dG = -B_j^T Q^T A_j dy +
+    // W M J_j^T A_j dy, and xi moves by M J_j^T A_j dy. Per unit of J_j^T A_j dy the output moves
+    // by G_pose = (Jc - lambda^T W) M.
+    Eigen::Matrix<double, 3, 6> G_pose = Eigen::Matrix<double, 3, 6>::Zero();
+    if (free_pose) G_pose = (Jc - lambda.transpose() * low.W) * low.M;
     TumourUncertainty u;
-    u.d_log_youngs_modulus = R_s * Vec3(-lambda.transpose() * b_E);
-    const Mat3 cov_E = sd_log_e * sd_log_e * u.d_log_youngs_modulus * u.d_log_youngs_modulus.transpose();
-    u.d_volume_compliance = R_s * Vec3(-lambda.transpose() * b_q);
+    u.d_log_youngs_modulus = R_out * Vec3(-lambda.transpose() * b_E);
+    u.d_volume_compliance = R_out * Vec3(-lambda.transpose() * b_q);
     const Mat3 cov_q = sd_q * sd_q * u.d_volume_compliance * u.d_volume_compliance.transpose();
     Mat3 cov_g = Mat3::Zero();
     if (gravity)
       for (int k = 0; k < 2; ++k) {
-        u.d_gravity_tilt[k] = R_s * Vec3(-lambda.transpose() * b_g[k]);
+        u.d_gravity_tilt[k] = R_out * Vec3(-lambda.transpose() * b_g[k]);
         cov_g += sd_theta * sd_theta * u.d_gravity_tilt[k] * u.d_gravity_tilt[k].transpose();
       }
-    // Depth noise: the held target of vertex v moves by delta along n, dG_v/d delta = -spring n.
+    // Depth noise: the held target of vertex v moves by delta along n, dG_v/d delta = -spring n
+    // (model frame; A n = spring n).
     Mat3 cov_d = Mat3::Zero();
     for (const HeldSkinVertex& h : held) {
       const int f = H.free_index(h.vertex);
-      if (f < 0) continue;
-      const Vec3 d = R_s * Vec3(spring * lambda.middleRows<3>(3 * f).transpose() * h.normal);
+      Vec3 d = Vec3::Zero();
+      if (f >= 0) d = spring * lambda.middleRows<3>(3 * f).transpose() * h.normal;
+      if (free_pose)  // lambda is the projector frame's adjoint already; the pose moves too
+        d += spring * G_pose * pose_jacobian(P * Vec3(x.row(h.vertex).transpose())).transpose() * (Q * h.normal);
+      d = R_out * d;
       cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
     }
+    // The landmarks sharing a free pose: target i moved by e_d (projector frame), A = w I.
+    Mat3 cov_l = Mat3::Zero();
+    if (landmarks_source) {
+      const double w = free_pose->landmark_weight;
+      u.d_landmarks.setZero(3, 3 * static_cast<Eigen::Index>(pose_anchors.size()));
+      for (size_t i = 0; i < pose_anchors.size(); ++i) {
+        const Anchor& a = pose_anchors[i];
+        const Eigen::Matrix<double, 3, 6> Ji = pose_jacobian(P * a.position(x));
+        for (int d = 0; d < 3; ++d) {
+          const Vec3 e = Vec3::Unit(d);
+          Vec3 local = Vec3::Zero();  // lambda^T B_i^T Q^T e (projector frame, as lambda is)
+          for (int k = 0; k < a.count; ++k) {
+            const int f = H.free_index(a.v[k]);
+            if (f >= 0) local += a.w[k] * lambda.middleRows<3>(3 * f).transpose() * (Q.transpose() * e);
+          }
+          Vec3 dc = w * (local + G_pose * Ji.transpose() * e);
+          dc = R_out * dc;
+          if (out.estimate_follows_landmarks)  // d ln E / dy, the fit in the model frame
+            dc += fit_motion.per_log_e.segment<3>(3 * static_cast<Eigen::Index>(i)).dot(Q.transpose() * e) /
+                  fit_motion.per_log_e.squaredNorm() * u.d_log_youngs_modulus;
+          u.d_landmarks.col(3 * static_cast<Eigen::Index>(i) + d) = dc;
+          cov_l += sd_landmark * sd_landmark * dc * dc.transpose();
+        }
+      }
+    }
+    const Mat3 cov_E = sd_log_e * sd_log_e * u.d_log_youngs_modulus * u.d_log_youngs_modulus.transpose();
     // The rigid pose: the centroid in the model frame moves by dc_m = -lambda^T b, and the moved
     // pose maps it back, c_s = R_s (c_m + dc_m - omega x c_m - tau).
-    const Vec3 c_m = volume_centroid(s);
-    for (int k = 0; k < 6; ++k) {
-      const Vec3 e = Vec3::Unit(k % 3);
-      const Vec3 moved_back = k < 3 ? Vec3(e.cross(c_m)) : e;
-      u.d_pose.col(k) = R_s * (Vec3(-lambda.transpose() * b_pose[k]) - moved_back);
-    }
+    if (!free_pose)  // (a free pose is not an input: it is solved)
+      for (int k = 0; k < 6; ++k) {
+        const Vec3 e = Vec3::Unit(k % 3);
+        const Vec3 moved_back = k < 3 ? Vec3(e.cross(c_m)) : e;
+        u.d_pose.col(k) = R_s * (Vec3(-lambda.transpose() * b_pose[k]) - moved_back);
+      }
     const Mat3 cov_p = pose_covariance ? Mat3(u.d_pose * *pose_covariance * u.d_pose.transpose()) : Mat3::Zero();
-    u.covariance = cov_E + cov_q + cov_g + cov_d + cov_p;
+    u.covariance = cov_E + cov_q + cov_g + cov_d + cov_p + cov_l;
     u.sources = {{"youngs_modulus", cov_E}, {"poisson_ratio", cov_q}, {"gravity_direction", cov_g}, {"depth_noise", cov_d}};
     if (pose_covariance) u.sources.emplace_back("rigid_pose", cov_p);
+    if (landmarks_source) u.sources.emplace_back("landmarks", cov_l);
     u.radius_95 = radius_95(u.covariance);
     out.tumours.push_back(u);
   }

@@ -187,18 +187,24 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   Json tumours = Json::array();
   for (size_t i = 0; i < r.tumours.size(); ++i) tumours.push_back(tumour_report(r.tumours[i], r.sampled_uncertainty ? &*r.sampled_uncertainty : nullptr, i));
   j["tumours"] = tumours;
-  // What the linear region leaves out, stated where it is read: on ring-free independent truth
-  // the landmarks' direct effect was most of the error at fat 1000 to 3400 Pa (BENCHMARKS.md,
-  // "The linear region leaves out the landmarks' direct effect").
+  // What the linear region leaves out, stated where it is read. With the pose solved with the
+  // deformation the landmarks share it and hold the skin, and they are a source (on ring-free
+  // independent truth their noise was most of the error: BENCHMARKS.md, issue 14); where ICP or
+  // the caller set the pose, they reach the result only as the surface step's start.
+  const bool landmarks_linearised = !r.tumours.empty() && r.tumours[0].uncertainty &&
+                                    r.tumours[0].uncertainty->d_landmarks.cols() > 0;
   if (!r.uncertainty_note.empty() || (!r.tumours.empty() && r.tumours[0].uncertainty))
     j["uncertainty"] = {{"method", "linear"},
                         {"validated", false},
                         {"seconds", num(r.uncertainty_seconds)},
                         {"note", r.uncertainty_note},
                         {"not_propagated",
-                         {"the supine landmarks' localisation (landmark_sd_mm), except through an estimated Young's "
-                          "modulus: its direct effect through the pose and where the skin settled is drawn by "
-                          "--uncertainty sampling",
+                         {landmarks_linearised
+                              ? "the landmark step's influence on where the surface step began (its start, not an input "
+                                "of the equilibrium): drawn by --uncertainty sampling"
+                              : "the supine landmarks' localisation (landmark_sd_mm), except through an estimated "
+                                "Young's modulus: its effect through the surface step's start is drawn by "
+                                "--uncertainty sampling",
                           "model error beyond the listed sources"}}};
   if (r.sampled_uncertainty)
     j["uncertainty_sampled"] = {{"samples", r.sampled_uncertainty->samples},

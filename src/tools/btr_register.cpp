@@ -42,7 +42,9 @@ int main(int argc, char** argv) {
       ->check(btr::cli::non_negative());
   app.add_option("--uncertainty", uncertainty,
                  "none; linear (experimental, not yet validated): each tumour centroid's covariance and 95 % radius "
-                 "from the Young's modulus, the gravity direction and the depth noise (tumour_uncertainty.h); sampling: "
+                 "from the Young's modulus, Poisson's ratio, the gravity direction, the depth noise, the rigid pose where "
+                 "ICP sets it and the landmarks where the pose is solved with the deformation (tumour_uncertainty.h); "
+                 "sampling: "
                  "the same from re-registrations with every source sampled (Young's modulus, Poisson's ratio, gravity "
                  "direction, landmarks, depth noise), beside the linear figures. The distributions are the scene's "
                  "`uncertainty:` section, else the defaults (uncertainty_sources.h)")

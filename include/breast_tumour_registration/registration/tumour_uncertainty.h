@@ -24,12 +24,14 @@
 // move rigidly in the model frame, the chest wall stays). Where the rest shape is an unloaded
 // one (RegistrationModel::unloaded_under) it moves with E and nu too: dX/dp from the unload's
 // own equation, G_prone(x_prone; X, p) = 0, by GMRES on differences of the gradient in X; its
-// effect joins dG/dp. Not covered by the linearisation: the landmarks' localisation (except
-// through an estimated E's sd) and the landmark step's influence on where the surface step ends
-// (it is a start, not an input, of the equilibrium), a pose solved with the landmarks or the skin
-// (held at its solution), E's estimate compensating a wrong Poisson's ratio unless the
-// landmark fit it came from is given (LandmarkStiffnessFit; the pipeline gives it), and model
-// error beyond these inputs. Sampling (RegistrationEngine::
+// effect joins dG/dp. Where the surface step solved the pose with the deformation (no rigid
+// region: FreePoseLinearisation) the pose stays free in the Jacobian and the landmarks that
+// share it are a source, jointly with an estimated E that was fitted on them. Not covered by the
+// linearisation: the landmarks' localisation where ICP or the caller set the pose (except
+// through an estimated E's sd), the landmark step's influence on where the surface step ends
+// (it is a start, not an input, of the equilibrium), E's estimate compensating a wrong
+// Poisson's ratio unless the landmark fit it came from is given (LandmarkStiffnessFit; the
+// pipeline gives it), and model error beyond these inputs. Sampling (RegistrationEngine::
 // sample_uncertainty) draws every source, the landmarks included.
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
@@ -97,6 +99,11 @@ struct TumourUncertainty {
   /// frame (supine -> model becomes exp(xi) of it; IcpResult::pose_covariance): the skin follows
   /// the moved data, the chest wall stays, and the result is mapped back by the moved pose.
   Eigen::Matrix<double, 3, 6> d_pose = Eigen::Matrix<double, 3, 6>::Zero();
+  /// With a free pose (FreePoseLinearisation): per metre of each supine landmark moving, column
+  /// 3 i + d for landmark i along axis d of the frame the supine surface was projected in
+  /// (supine frame) [m/m]; the estimated E's response to it included when the landmark fit is
+  /// given. Empty otherwise.
+  Eigen::Matrix<double, 3, Eigen::Dynamic> d_landmarks;
 };
 
 struct UncertaintyResult {
@@ -112,6 +119,13 @@ struct UncertaintyResult {
   /// (0: not followed, E taken independent of nu).
   bool estimate_follows_poisson_ratio = false;
   double log_youngs_modulus_per_compliance = 0;
+  /// With the landmarks a source (a free pose) and the landmark fit an estimated E came from:
+  /// the estimate moves with the landmarks (jointly with their direct effect), and E's own
+  /// source keeps only the part of its sd the landmarks' noise does not explain.
+  bool estimate_follows_landmarks = false;
+  /// Then: the sd of ln E the landmarks' noise gives the estimate (their sd over |dr/d ln E|, as
+  /// linearised here), and the sd E keeps as an independent source (the rest of the estimate's).
+  double log_sd_from_landmarks = 0, log_sd_independent = 0;
 };
 
 /// The volume compliance q = mu / lambda_L = (1 - 2 nu) / (2 nu) of Poisson's ratio nu: the
@@ -145,25 +159,44 @@ struct HeldSkinVertex {
   Vec3 normal = Vec3::UnitZ();
 };
 
+/// Where the surface step solved the pose jointly with the deformation (no rigid region
+/// decides it; RigidFreeSurfaceEnergy): the pose it ended on and the landmarks that share it
+/// (SurfaceStepOptions::pose_points_weight). The linearisation then keeps the pose free, as
+/// that energy does (eliminated, its Hessian's rank-6 part applied by the Woodbury identity),
+/// maps the centroids out through the pose as it moves, and takes the supine landmarks'
+/// localisation (UncertaintySources::landmark_sd) as a source: each target moving isotropically.
+/// On ring-free bodies those springs hold the skin's sliding and the pose where the landmarks
+/// put them, and their noise was most of the error (BENCHMARKS.md, issue 14).
+struct FreePoseLinearisation {
+  Rigid model_to_projector = Rigid::Identity();  ///< the pose the surface step ended on
+  std::vector<Anchor> landmarks;
+  Points landmark_targets;   ///< in the projector's frame, one row per landmark (0 rows: none)
+  double landmark_weight = 0;  ///< [N/m] per landmark
+};
+
 /// The linearisation at x with these held skin vertices (the core of the function below, which
 /// projects the skin first).
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const std::vector<HeldSkinVertex>& held, const Rigid& model_to_supine,
                                                 const SurfaceStepOptions& surface, const UncertaintyOptions& opt,
                                                 const std::optional<Mat6>& pose_covariance = std::nullopt,
-                                                const LandmarkStiffnessFit* stiffness_fit = nullptr);
+                                                const LandmarkStiffnessFit* stiffness_fit = nullptr,
+                                                const FreePoseLinearisation* free_pose = nullptr);
 
 /// x: the surface step's equilibrium (model frame); supine: the projector it ended on, which
 /// sees the model through model_to_projector; model_to_supine maps the result into the supine
 /// frame. pose_covariance: that of the rigid pose (supine -> model) as IcpResult::
-/// pose_covariance gives it, a source "rigid_pose"; none: the pose is held. Throws SolverError
-/// when the fixed-point Jacobian cannot be factorized.
+/// pose_covariance gives it, a source "rigid_pose"; none: the pose is held. free_pose: the pose
+/// was solved with the deformation (then no pose_covariance; model_to_projector is its pose), a
+/// source "landmarks" where landmarks share it. Throws SolverError when the fixed-point Jacobian
+/// cannot be factorized, InputError for a free pose with a covariance.
 UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, const Points& x,
                                                 const SurfaceProjector& supine, const Rigid& model_to_projector,
                                                 const Rigid& model_to_supine, const SurfaceStepOptions& surface,
                                                 const UncertaintyOptions& opt,
                                                 const std::optional<Mat6>& pose_covariance = std::nullopt,
-                                                const LandmarkStiffnessFit* stiffness_fit = nullptr);
+                                                const LandmarkStiffnessFit* stiffness_fit = nullptr,
+                                                const FreePoseLinearisation* free_pose = nullptr);
 
 /// The spread of the registered tumour centroids over whole re-registrations with sampled
 /// inputs (RegistrationEngine::sample_uncertainty): the reference the linearisation is judged by,
