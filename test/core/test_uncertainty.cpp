@@ -342,7 +342,7 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
     ASSERT_TRUE(t.uncertainty) << t.name;
     EXPECT_EQ(t.uncertainty->d_landmarks.cols(), 3 * targets.rows()) << t.name;
   }
-  EXPECT_NE(p.uncertainty_note.find("linearised free; the landmarks that share it are a source"),
+  EXPECT_NE(p.uncertainty_note.find("linearised free, the skin free to slide; the landmarks that share it are a source"),
             std::string::npos) << p.uncertainty_note;
 }
 
