@@ -29,7 +29,7 @@ struct UncertaintySources {
   /// spread about the nominal over it: tumour_uncertainty.h). {0, 0}: held.
   std::array<double, 2> poisson_ratio_range{0.45, 0.499};
   double gravity_direction_deg = 2.0;  ///< sd of the supine gravity's tilt about each horizontal axis [deg]
-  double landmark_sd = 0.0015;         ///< sd of each supine landmark's position, per axis [m] (sampling only)
+  double landmark_sd = 0.0015;         ///< sd of each supine landmark's position, per axis [m] (sampling; the linear region where the pose is solved with the deformation)
   double depth_noise = 0.001;          ///< sd of the supine surface and rigid region along their normals, per vertex [m]
   /// The rigid pose ICP fits on the rigid regions, as uncertain as its fit (and, sampled, the
   /// rigid region's depth noise) makes it; false: held at its solution.
