@@ -30,19 +30,8 @@ using btr::test::expect_throw_with;
 
 namespace {
 
-/// The minimum of the surface step's last Newton problem with these held skin targets (moved
-/// rigidly by `move`), the model's material and rest shape, and `gravity`: solved to round-off
-/// from `start`.
-Points held_energy_minimum(const RegistrationModel& m, const std::vector<HeldSkinVertex>& held, const Rigid& move,
-                           const Vec3& gravity, const SurfaceStepOptions& surface, const Points& start) {
-  TotalEnergy energy;
-  add_model_elastic_energy(energy, m);
-  energy.add(std::make_shared<GravityEnergy>(m.rest, m.material.density, gravity));
-  auto springs = std::make_shared<SpringEnergy>();
-  for (const HeldSkinVertex& k : held)
-    springs->add_point_and_plane(Anchor::vertex(k.vertex), move * k.point, move.linear() * k.normal, surface.point_weight,
-                                 surface.plane_weight);
-  energy.add(springs);
+/// The minimum of `energy` on m's mesh (chest wall fixed), solved to round-off from `start`.
+Points minimum_to_round_off(const RegistrationModel& m, const TotalEnergy& energy, const Points& start) {
   NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.rest.V.rows()), m.rest.T, m.fixed,
                                                          energy.hessian_cliques()),
                       m.rest.T);
@@ -56,6 +45,22 @@ Points held_energy_minimum(const RegistrationModel& m, const std::vector<HeldSki
   // Tolerances far below round-off: a stall at 1e-8 N of a 3 N weight is the minimum too.
   EXPECT_TRUE(nr.converged || nr.gradient_norm < 1e-6) << to_string(nr.reason) << ", gradient " << nr.gradient_norm << " N after " << nr.iterations;
   return x;
+}
+
+/// The minimum of the surface step's last Newton problem with these held skin targets (moved
+/// rigidly by `move`), the model's material and rest shape, and `gravity`: solved to round-off
+/// from `start`.
+Points held_energy_minimum(const RegistrationModel& m, const std::vector<HeldSkinVertex>& held, const Rigid& move,
+                           const Vec3& gravity, const SurfaceStepOptions& surface, const Points& start) {
+  TotalEnergy energy;
+  add_model_elastic_energy(energy, m);
+  energy.add(std::make_shared<GravityEnergy>(m.rest, m.material.density, gravity));
+  auto springs = std::make_shared<SpringEnergy>();
+  for (const HeldSkinVertex& k : held)
+    springs->add_point_and_plane(Anchor::vertex(k.vertex), move * k.point, move.linear() * k.normal, surface.point_weight,
+                                 surface.plane_weight);
+  energy.add(springs);
+  return minimum_to_round_off(m, energy, start);
 }
 
 /// The tumours' volume centroids at x, model frame.
@@ -255,17 +260,7 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
     RegistrationModel m = model;
     scale_stiffness(m, std::exp(log_e));
     auto [e, fs] = energy_with(m, lm, gravity);
-    NewtonSolver solver(std::make_shared<HessianAssembler>(static_cast<int>(m.rest.V.rows()), m.rest.T, m.fixed,
-                                                           e->hessian_cliques()),
-                        m.rest.T);
-    NewtonOptions n;
-    n.gradient_rel_tolerance = 1e-13;
-    n.gradient_abs_tolerance = 1e-13;
-    n.step_tolerance = 1e-15;
-    n.reuse_factorization = false;
-    Points x = start;
-    const NewtonResult nr = solver.solve(*e, x, n);
-    EXPECT_TRUE(nr.converged || nr.gradient_norm < 1e-6) << to_string(nr.reason) << ", gradient " << nr.gradient_norm;
+    const Points x = minimum_to_round_off(m, *e, start);
     const Rigid to_supine = T.inverse() * fs->pose(x);
     std::vector<Vec3> c = tumour_centroids(m, x);
     for (Vec3& ci : c) ci = to_supine * ci;
