@@ -54,19 +54,28 @@ void RigidFreeSurfaceEnergy::rebuild() {
   A_.insert(A_.end(), point_A_.begin(), point_A_.end());
 }
 
+Vec3 RigidFreeSurfaceEnergy::turning_centre(const Points& x, const Rigid& P) const {
+  Vec3 c = Vec3::Zero();
+  for (const Anchor& a : anchors_) c += P * a.position(x);
+  return c / static_cast<double>(anchors_.size());
+}
+
+Eigen::Matrix<double, 3, 6> RigidFreeSurfaceEnergy::twist_jacobian(const Vec3& q, const Vec3& centre) {
+  Eigen::Matrix<double, 3, 6> J;
+  J << -cross_matrix(q - centre), Mat3::Identity();
+  return J;
+}
+
 Rigid RigidFreeSurfaceEnergy::pose(const Points& x) const {
   if (anchors_.size() < 3) throw InputError("solving the pose on the surface needs at least 3 correspondences");
   Rigid P = warm_;
   for (int it = 0; it < 50; ++it) {
-    Vec3 c = Vec3::Zero();
-    for (const Anchor& a : anchors_) c += P * a.position(x);
-    c /= static_cast<double>(anchors_.size());
+    const Vec3 c = turning_centre(x, P);
     Mat6 F = Mat6::Zero();
     Vec6 b = Vec6::Zero();
     for (size_t j = 0; j < anchors_.size(); ++j) {
       const Vec3 q = P * anchors_[j].position(x);
-      Eigen::Matrix<double, 3, 6> J;
-      J << -cross_matrix(q - c), Mat3::Identity();
+      const Eigen::Matrix<double, 3, 6> J = twist_jacobian(q, c);
       F += J.transpose() * A_[j] * J;
       b += J.transpose() * A_[j] * (q - y_[j]);
     }
@@ -122,16 +131,13 @@ void RigidFreeSurfaceEnergy::add_low_rank_hessian(const Points& x, std::vector<L
   if (anchors_.empty()) return;
   const Rigid P = pose(x);
   const Mat3 Qt = P.linear().transpose();
-  Vec3 c = Vec3::Zero();
-  for (const Anchor& a : anchors_) c += P * a.position(x);
-  c /= static_cast<double>(anchors_.size());
+  const Vec3 c = turning_centre(x, P);
   LowRankHessian part;
   part.W.setZero(x.size(), 6);
   Mat6 F = Mat6::Zero();
   for (size_t j = 0; j < anchors_.size(); ++j) {
     const Anchor& a = anchors_[j];
-    Eigen::Matrix<double, 3, 6> J;
-    J << -cross_matrix(P * a.position(x) - c), Mat3::Identity();
+    const Eigen::Matrix<double, 3, 6> J = twist_jacobian(P * a.position(x), c);
     F += J.transpose() * A_[j] * J;
     const Eigen::Matrix<double, 3, 6> QAJ = Qt * A_[j] * J;
     for (int k = 0; k < a.count; ++k) part.W.middleRows<3>(3 * a.v[k]) += a.w[k] * QAJ;

@@ -17,7 +17,6 @@
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/rigid_free_surface_energy.h"
-#include "breast_tumour_registration/fem/small_matrices.h"
 #include "breast_tumour_registration/fem/spring_energy.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
@@ -350,9 +349,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     }
     P = fs->pose(x);
     Q = P.linear();
-    for (const HeldSkinVertex& h : held) cbar += P * Vec3(x.row(h.vertex).transpose());
-    for (const Anchor& a : pose_anchors) cbar += P * a.position(x);
-    cbar /= static_cast<double>(held.size() + pose_anchors.size());
+    cbar = fs->turning_centre(x, P);
     jac.add(fs);
   } else {
     auto springs = std::make_shared<SpringEnergy>("held skin");
@@ -383,11 +380,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     return d;
   };
   // The pose's motion xi = (omega about cbar, tau) per correspondence: d(P p) = J xi.
-  auto pose_jacobian = [&](const Vec3& p_projector) {
-    Eigen::Matrix<double, 3, 6> J;
-    J << -cross_matrix(p_projector - cbar), Mat3::Identity();
-    return J;
-  };
+  auto pose_jacobian = [&](const Vec3& p_projector) { return RigidFreeSurfaceEnergy::twist_jacobian(p_projector, cbar); };
 
   // Inputs' dG/dp on the free DOFs. G_elastic is linear in E: dG/d ln E = G_elastic. Poisson's
   // ratio enters through the volume compliance q = (1 - 2 nu) / (2 nu), in which the response

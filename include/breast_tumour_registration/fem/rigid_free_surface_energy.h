@@ -45,6 +45,12 @@ class RigidFreeSurfaceEnergy : public EnergyTerm {
 
   /// The best pose for x: model frame -> scan frame. Needs >= 3 correspondences.
   Rigid pose(const Points& x) const;
+  /// The point the pose turns about at x under pose P: the mean of the correspondences' P x
+  /// (surface and point anchors alike). The twist xi = (omega, tau) moves each by
+  /// twist_jacobian(P x_j, centre) xi.
+  Vec3 turning_centre(const Points& x, const Rigid& P) const;
+  /// d(P x_j) / d xi for the small motion exp(xi) about `centre`: [-(q - centre)^, I].
+  static Eigen::Matrix<double, 3, 6> twist_jacobian(const Vec3& q, const Vec3& centre);
 
  private:
   void rebuild();
