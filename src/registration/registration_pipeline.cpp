@@ -306,6 +306,11 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
         if (targets.rows() >= 3) {
           free_pose->landmarks = scene.landmark_anchors;
           free_pose->landmark_targets = transform_points(to_projector, targets);
+          if (opt.surface.landmarks_on_scan) {  // as the surface step took them
+            LandmarksOnScan on = landmarks_on_scan(*supine, free_pose->landmark_targets, opt.surface);
+            free_pose->landmark_targets = std::move(on.targets);
+            free_pose->landmark_normals = std::move(on.normals);
+          }
         }
       }
       const UncertaintyResult u = linearised_tumour_uncertainty(model, r.x, *supine, to_projector, to_supine, computed,

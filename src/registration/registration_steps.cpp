@@ -188,6 +188,12 @@ class SurfaceGuidedStep : public RegistrationStep {
     const bool free_pose = (r.steps.rigid_landmarks || r.steps.rigid_icp) && !r.icp_used;
     PosePoints lm{c.scene.landmark_anchors, c.targets};
     const SurfaceProjector& supine = *c.supine();
+    // Skin landmarks on the scan: their depth is the scan's (SurfaceStepOptions::landmarks_on_scan).
+    if (free_pose && c.opt.surface.landmarks_on_scan && c.targets.rows() >= 3) {
+      const LandmarksOnScan on = landmarks_on_scan(supine, c.targets, c.opt.surface);
+      lm.targets = on.targets;
+      r.landmarks_moved_onto_scan = on.moved;
+    }
     r.reports.push_back(surface_step(c.model(), supine, c.opt.surface, r.x, c.callback, free_pose ? &c.to_projector : nullptr,
                                      c.targets.rows() >= 3 ? &lm : nullptr, c.solvers));
     r.pose_solved_with_surface = free_pose;

@@ -22,6 +22,18 @@ bool holds_projection(const Projection& c, const SurfaceStepOptions& opt) {
   return !(opt.reject_boundary && c.on_boundary);
 }
 
+LandmarksOnScan landmarks_on_scan(const SurfaceProjector& supine, const Points& targets, const SurfaceStepOptions& opt) {
+  LandmarksOnScan out{targets, Points::Zero(targets.rows(), 3), 0};
+  for (Eigen::Index i = 0; i < targets.rows(); ++i) {
+    const Projection c = supine.project(Vec3(targets.row(i).transpose()));
+    if (!holds_projection(c, opt) || !c.point.allFinite() || !(c.normal.norm() > 0)) continue;
+    out.targets.row(i) = c.point.transpose();
+    out.normals.row(i) = c.normal.normalized().transpose();
+    ++out.moved;
+  }
+  return out;
+}
+
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
                         Points& x, const StepCallback& callback, Rigid* pose, const PosePoints* pose_points,
                         StepSolvers* cache) {

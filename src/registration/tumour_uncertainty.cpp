@@ -311,6 +311,8 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     throw InputError("uncertainty: a pose solved with the deformation is not an input with a covariance");
   if (free_pose && static_cast<Eigen::Index>(free_pose->landmarks.size()) != free_pose->landmark_targets.rows())
     throw InputError("uncertainty: the landmarks sharing the pose and their targets differ in number");
+  if (free_pose && free_pose->landmark_normals.rows() > 0 && free_pose->landmark_normals.rows() != free_pose->landmark_targets.rows())
+    throw InputError("uncertainty: the landmarks sharing the pose and their normals differ in number");
 
   // The fixed point's Jacobian: elastic + held skin along its normals.
   TotalEnergy elastic;
@@ -526,17 +528,25 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
     if (landmarks_source) {
       const double w = free_pose->landmark_weight;
       u.d_landmarks.setZero(3, 3 * static_cast<Eigen::Index>(pose_anchors.size()));
+      const Points& normals = free_pose->landmark_normals;
       for (size_t i = 0; i < pose_anchors.size(); ++i) {
         const Anchor& a = pose_anchors[i];
         const Eigen::Matrix<double, 3, 6> Ji = pose_jacobian(P * a.position(x));
+        // A target moved onto the scan follows its landmark along the surface only.
+        Mat3 follows = Mat3::Identity();
+        if (normals.rows() > static_cast<Eigen::Index>(i)) {
+          const Vec3 n = normals.row(static_cast<Eigen::Index>(i)).transpose();
+          follows -= n * n.transpose();
+        }
         for (int d = 0; d < 3; ++d) {
           const Vec3 e = Vec3::Unit(d);
-          Vec3 local = Vec3::Zero();  // lambda^T B_i^T Q^T e (projector frame, as lambda is)
+          const Vec3 moved = follows * e;  // the target's motion (projector frame)
+          Vec3 local = Vec3::Zero();  // lambda^T B_i^T Q^T moved (projector frame, as lambda is)
           for (int k = 0; k < a.count; ++k) {
             const int f = H.free_index(a.v[k]);
-            if (f >= 0) local += a.w[k] * lambda.middleRows<3>(3 * f).transpose() * (Q.transpose() * e);
+            if (f >= 0) local += a.w[k] * lambda.middleRows<3>(3 * f).transpose() * (Q.transpose() * moved);
           }
-          Vec3 dc = w * (local + G_pose * Ji.transpose() * e);
+          Vec3 dc = w * (local + G_pose * Ji.transpose() * moved);
           dc = R_out * dc;
           if (out.estimate_follows_landmarks)  // d ln E / dy, the fit in the model frame
             dc += fit_motion.per_log_e.segment<3>(3 * static_cast<Eigen::Index>(i)).dot(Q.transpose() * e) /

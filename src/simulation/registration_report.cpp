@@ -159,6 +159,7 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
       {"icp_used", r.icp_used},
       {"pose_solved_with_landmarks", r.pose_solved_with_landmarks},
       {"pose_solved_with_surface", r.pose_solved_with_surface},
+      {"landmarks_moved_onto_scan", r.landmarks_moved_onto_scan},
       {"icp_vs_landmark_pose_mm", num(r.pose_disagreement * 1e3)},
       {"rigid_regions",
        {{"distinct_poses", r.rigid_distinct_poses},

@@ -769,6 +769,35 @@ TEST(SurfaceProjector, FlagsClosestPointsOnTheBorderOfAnOpenSurface) {
   for (const Vec3& p : {Vec3(2, 0, 0), Vec3(0.1, 0.2, 0.3), Vec3(-1, 1, 1)}) EXPECT_FALSE(closed->project(p).on_boundary);
 }
 
+TEST(SurfaceStep, LandmarksOnTheScanTakeTheirDepthFromItAndKeepWhatItDoesNotHold) {
+  // A 10 cm square scan in z = 0 (metres). A landmark 2 mm above its inside is moved onto it,
+  // with the normal there; one beyond max_projection_distance and one past its border (a skin
+  // vertex would not be held there either) are kept as given, with a zero normal.
+  SurfaceMesh sq;
+  sq.V.resize(4, 3);
+  sq.V << 0, 0, 0, 0.1, 0, 0, 0.1, 0.1, 0, 0, 0.1, 0;
+  sq.F.resize(2, 3);
+  sq.F << 0, 1, 2, 0, 2, 3;
+  const auto scan = make_mesh_projector(sq);
+  SurfaceStepOptions o;
+  Points t(3, 3);
+  t << 0.03, 0.04, 0.002,   // above the inside
+      0.05, 0.05, 0.05,     // 5 cm above: farther than max_projection_distance (3 cm)
+      0.12, 0.05, 0.001;    // beyond a side: its closest point is on the border
+  const LandmarksOnScan on = landmarks_on_scan(*scan, t, o);
+  EXPECT_EQ(on.moved, 1);
+  EXPECT_LT((on.targets.row(0) - Eigen::RowVector3d(0.03, 0.04, 0)).norm(), 1e-12);
+  EXPECT_NEAR(std::abs(on.normals(0, 2)), 1.0, 1e-12);
+  for (Eigen::Index i : {1, 2}) {
+    EXPECT_EQ(on.targets.row(i), t.row(i)) << i;
+    EXPECT_EQ(on.normals.row(i).norm(), 0.0) << i;
+  }
+  // Nearer than the distance cap the far landmark is moved too; with the border allowed, so is the last.
+  o.max_projection_distance = 0.1;
+  o.reject_boundary = false;
+  EXPECT_EQ(landmarks_on_scan(*scan, t, o).moved, 3);
+}
+
 TEST(SurfaceProjector, InterpolatedNormalsAreContinuousAcrossEdgesAndCloserToTheSmoothSurface) {
   // A coarse sphere (162 vertices): its face normals jump by about 14 deg across an edge.
   const SurfaceMesh sphere = make_icosphere(Vec3::Zero(), 1.0, 2);

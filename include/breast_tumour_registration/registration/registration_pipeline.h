@@ -125,6 +125,8 @@ struct RegistrationResult {
   IcpResult icp;
   bool pose_solved_with_landmarks = false;  ///< the landmark step solved the pose (no decisive ICP)
   bool pose_solved_with_surface = false;    ///< the surface step refined it (no decisive ICP)
+  /// There: the landmark targets it moved onto the supine surface (SurfaceStepOptions::landmarks_on_scan)
+  int landmarks_moved_onto_scan = 0;
   int rigid_distinct_poses = 0;       ///< distinct poses the rigid regions fit equally well (> 1: symmetric)
   bool rigid_decided_by_landmarks = false;  ///< several of them, and the landmarks chose
   bool rigid_pose_undecided = false;  ///< several of them and nothing told them apart (a warning says so)

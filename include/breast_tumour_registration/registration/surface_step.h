@@ -70,6 +70,14 @@ struct SurfaceStepOptions {
   double max_projection_distance = 0.03;
   /// With a free pose: the weight [N/m] of the point springs (landmarks) that share the pose.
   double pose_points_weight = 1e4;
+  /// With a free pose: each landmark target that the supine surface holds as it holds the skin
+  /// (holds_projection) is moved to its closest point there (landmarks_on_scan). Landmarks are
+  /// skin markers: the scan says how deep the skin lies, the landmark where along the surface.
+  /// Taken as given, a landmark's localisation noise along the normal (1.5 mm) pits its spring
+  /// against the skin springs around it, and on soft tissue the skin there folded and flipped
+  /// between two states at every projection (3 of 8 sampled re-registrations stalled on SfePy's
+  /// fat 1000 Pa body with landmark and depth noise: BENCHMARKS.md, "Landmarks on the scan").
+  bool landmarks_on_scan = true;
   /// Projections onto the border of an open supine surface (the edge of a depth scan, the
   /// rim of a hole behind an occlusion) are dropped: that skin is not in the scan.
   bool reject_boundary = true;
@@ -122,6 +130,18 @@ struct PosePoints {
   std::vector<Anchor> anchors;
   Points targets;
 };
+
+/// Landmark targets as the pose-free surface step takes them (SurfaceStepOptions::
+/// landmarks_on_scan): a target whose projection onto `supine` holds_projection is replaced by
+/// that closest point, with the surface's unit normal there; any other target is kept as given,
+/// with a zero normal. Targets and surface in one frame. Only the tangential motion of a moved
+/// target moves it (to first order): what the linearised uncertainty takes of the landmarks.
+struct LandmarksOnScan {
+  Points targets;   ///< one row per target
+  Points normals;   ///< the surface's unit normal at the moved target; zero: kept as given
+  int moved = 0;    ///< how many targets were moved onto the surface
+};
+LandmarksOnScan landmarks_on_scan(const SurfaceProjector& supine, const Points& targets, const SurfaceStepOptions& opt);
 StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& supine, const SurfaceStepOptions& opt,
                         Points& x, const StepCallback& callback = {}, Rigid* pose = nullptr,
                         const PosePoints* pose_points = nullptr, StepSolvers* cache = nullptr);

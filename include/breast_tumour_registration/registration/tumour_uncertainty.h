@@ -176,6 +176,10 @@ struct FreePoseLinearisation {
   std::vector<Anchor> landmarks;
   Points landmark_targets;   ///< in the projector's frame, one row per landmark (0 rows: none)
   double landmark_weight = 0;  ///< [N/m] per landmark
+  /// Per landmark (or 0 rows: none): a unit normal where the surface step moved the target onto
+  /// the scan (LandmarksOnScan::normals), so that only the landmark's motion along the surface
+  /// moves it; a zero row: the target moves with its landmark.
+  Points landmark_normals;
 };
 
 /// The linearisation at x with these held skin vertices (the core of the function below, which
