@@ -523,32 +523,40 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       d = R_out * d;
       cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
     }
-    // The landmarks sharing a free pose: target i moved by e_d (projector frame), A = w I.
+    // The landmarks sharing a free pose, A = w I: the output's motion (supine frame) when target
+    // i moves by `moved` (projector frame).
+    auto target_response = [&](size_t i, const Vec3& moved) {
+      const Anchor& a = pose_anchors[i];
+      Vec3 local = Vec3::Zero();  // lambda^T B_i^T Q^T moved (projector frame, as lambda is)
+      for (int k = 0; k < a.count; ++k) {
+        const int f = H.free_index(a.v[k]);
+        if (f >= 0) local += a.w[k] * lambda.middleRows<3>(3 * f).transpose() * (Q.transpose() * moved);
+      }
+      return Vec3(R_out * (free_pose->landmark_weight * (local + G_pose * pose_jacobian(P * a.position(x)).transpose() * moved)));
+    };
+    // A target the step moved onto the scan (landmarks_on_scan) follows its landmark along the
+    // surface only, and the scan's depth noise there along the normal.
+    const Points* normals = free_pose && free_pose->landmark_normals.rows() > 0 ? &free_pose->landmark_normals : nullptr;
+    if (normals)
+      for (size_t i = 0; i < pose_anchors.size(); ++i) {
+        const Vec3 n = normals->row(static_cast<Eigen::Index>(i)).transpose();
+        if (n.squaredNorm() == 0) continue;
+        const Vec3 d = target_response(i, n);
+        cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
+      }
     Mat3 cov_l = Mat3::Zero();
     if (landmarks_source) {
-      const double w = free_pose->landmark_weight;
       u.d_landmarks.setZero(3, 3 * static_cast<Eigen::Index>(pose_anchors.size()));
-      const Points& normals = free_pose->landmark_normals;
       for (size_t i = 0; i < pose_anchors.size(); ++i) {
-        const Anchor& a = pose_anchors[i];
-        const Eigen::Matrix<double, 3, 6> Ji = pose_jacobian(P * a.position(x));
-        // A target moved onto the scan follows its landmark along the surface only.
         Mat3 follows = Mat3::Identity();
-        if (normals.rows() > static_cast<Eigen::Index>(i)) {
-          const Vec3 n = normals.row(static_cast<Eigen::Index>(i)).transpose();
+        if (normals) {
+          const Vec3 n = normals->row(static_cast<Eigen::Index>(i)).transpose();
           follows -= n * n.transpose();
         }
         for (int d = 0; d < 3; ++d) {
           const Vec3 e = Vec3::Unit(d);
-          const Vec3 moved = follows * e;  // the target's motion (projector frame)
-          Vec3 local = Vec3::Zero();  // lambda^T B_i^T Q^T moved (projector frame, as lambda is)
-          for (int k = 0; k < a.count; ++k) {
-            const int f = H.free_index(a.v[k]);
-            if (f >= 0) local += a.w[k] * lambda.middleRows<3>(3 * f).transpose() * (Q.transpose() * moved);
-          }
-          Vec3 dc = w * (local + G_pose * Ji.transpose() * moved);
-          dc = R_out * dc;
-          if (out.estimate_follows_landmarks)  // d ln E / dy, the fit in the model frame
+          Vec3 dc = target_response(i, follows * e);
+          if (out.estimate_follows_landmarks)  // d ln E / dy, the fit in the model frame (the landmarks as given)
             dc += fit_motion.per_log_e.segment<3>(3 * static_cast<Eigen::Index>(i)).dot(Q.transpose() * e) /
                   fit_motion.per_log_e.squaredNorm() * u.d_log_youngs_modulus;
           u.d_landmarks.col(3 * static_cast<Eigen::Index>(i) + d) = dc;

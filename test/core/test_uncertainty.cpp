@@ -403,6 +403,21 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
   EXPECT_GT(fd_on, 0.1 * fd_given);  // the tangential response is there, of the order of the full one
   EXPECT_LT(fd_on, 0.9 * fd_given);  // and the normal part is gone
   EXPECT_LT(along_normal, 1e-9);
+  // Along the normal such a target carries the scan's depth noise: the depth-noise share grows by
+  // each target's response along its normal (checked above as the targets' own response).
+  for (size_t i = 0; i < r.tumours.size(); ++i) {
+    double expected = 0;
+    for (Eigen::Index l = 0; l < on.targets.rows(); ++l)
+      expected += (lin_given.tumours[i].d_landmarks.middleCols<3>(3 * l) * Vec3(on.normals.row(l).transpose())).squaredNorm();
+    expected *= o.uncertainty.sources.depth_noise * o.uncertainty.sources.depth_noise;
+    const auto depth_share = [](const TumourUncertainty& u) {
+      for (const auto& [name, cov] : u.sources)
+        if (name == "depth_noise") return cov.trace();
+      return -1.0;
+    };
+    EXPECT_GT(expected, 0);
+    EXPECT_NEAR(depth_share(lin_on.tumours[i]) - depth_share(lin_given.tumours[i]), expected, 1e-9 * expected + 1e-18) << r.tumours[i].name;
+  }
   // The pipeline linearises so where it solved the pose with the deformation, and says so.
   o.uncertainty.held_projections = false;
   const RegistrationResult p = engine.solve(o);
@@ -413,6 +428,13 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
   }
   EXPECT_NE(p.uncertainty_note.find("linearised free, the skin free to slide; the landmarks that share it are a source"),
             std::string::npos) << p.uncertainty_note;
+  // Its landmarks lie on the scan (the phantom's skin vertices): each was moved onto it.
+  EXPECT_EQ(p.landmarks_moved_onto_scan, targets.rows());
+  const std::string d = btr::test::temp_dir();
+  write_registration_outputs(d, engine.prepare(o).scene, engine.prepare(o).model, p, 0);
+  std::ifstream report(d + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(report);
+  EXPECT_EQ(j.at("rigid_transform_supine_to_model").at("landmarks_moved_onto_scan").get<int>(), targets.rows());
 }
 
 // Poisson's ratio, and an unloaded rest shape moving with the material. On a model unloaded

@@ -26,7 +26,10 @@
 // own equation, G_prone(x_prone; X, p) = 0, by GMRES on differences of the gradient in X; its
 // effect joins dG/dp. Where the surface step solved the pose with the deformation (no rigid
 // region: FreePoseLinearisation) the pose stays free in the Jacobian and the landmarks that
-// share it are a source, jointly with an estimated E that was fitted on them; the pipeline then
+// share it are a source, jointly with an estimated E that was fitted on them (where the step
+// moved their targets onto the scan, SurfaceStepOptions::landmarks_on_scan, a landmark moves
+// its target along the surface only, and the scan's depth noise there moves it along the
+// normal; the stiffness fit takes the landmarks as given); the pipeline then
 // linearises with the skin free to slide (SkinSliding::Free), however the step ended, as
 // measured on two independent bodies (BENCHMARKS.md, "The linear region with the pose free").
 // Not covered by the linearisation: the landmarks' localisation where ICP or the caller set the
