@@ -3,8 +3,11 @@
 // with a 2x gland and 6x tumours, a sheared asymmetric body without a chest ring), committed
 // small in test/data (bench/make_independent_truth.py wrote it). Our own phantom's truth shares
 // the method's mesh type and material; this one shares neither.
+#include <random>
 #include <string>
 
+#include "breast_tumour_registration/geometry/vertex_normals.h"
+#include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "test_util.h"
@@ -123,4 +126,36 @@ TEST(SurfaceStep, HeldSlidingChangesNothingWhereFreeSlidingContractsQuickly) {
   EXPECT_EQ(held.reports.back().sliding_held_from, 0) << step_stops(held);
   EXPECT_EQ(held.reports.back().outer_iterations, free.reports.back().outer_iterations);
   EXPECT_NEAR(worst_error(held), worst_error(free), 1e-9);
+}
+
+TEST(SurfaceStep, NoisyLandmarksOnANoisyScanNoLongerFoldTheSkinBesideThem) {
+  // Issues 10 and 14: the supine side as uncertainty sampling draws it (1.5 mm per landmark
+  // coordinate, 1 mm of depth noise), SfePy's fat 1000 Pa body, E estimated, nodal, balanced.
+  // Taken as given, a landmark's noise along the normal pulled its vertex off the scan against
+  // the skin springs beside it; the skin there folded and flipped at every projection, and the
+  // pose-free surface step stalled (this draw; 2 of 12 and 6 of 16 on the two SfePy bodies,
+  // BENCHMARKS.md, "Landmarks on the scan"). Moved onto the scan, the targets let it converge,
+  // its error within 0.2 mm of the stalled state's (2.20 against 2.13 mm for this draw; the
+  // means over the draws were the same).
+  const Scene s = load_scene(std::string(BTR_TEST_DATA_DIR) + "/independent_truth_E1000/scene_estimated_regions_nodal.yaml");
+  Scene noisy = s;
+  std::mt19937 rng(1);  // bench/probes/noisy_landmarks_scan.cpp's first seed
+  std::normal_distribution<double> z(0, 1);
+  for (Eigen::Index l = 0; l < noisy.landmark_supine.rows(); ++l)
+    for (int j = 0; j < 3; ++j) noisy.landmark_supine(l, j) += 0.0015 * z(rng);
+  displace_along_normals(*noisy.supine_surface, 0.001, [&] { return z(rng); });
+  RegistrationEngine engine(s);
+  RegistrationOptions o = preset_options("balanced");
+  const RegistrationResult on = engine.solve(noisy, o);
+  o.surface.landmarks_on_scan = false;
+  const RegistrationResult given = engine.solve(noisy, o);
+  std::printf("noisy landmarks and scan: moved onto the scan %s, worst tumour %.3f mm; as given %s, %.3f mm\n",
+              on.converged ? "converged" : "not converged", worst_error(on) * 1e3, given.converged ? "converged" : "not converged",
+              worst_error(given) * 1e3);
+  ASSERT_TRUE(on.pose_solved_with_surface);
+  EXPECT_EQ(on.landmarks_moved_onto_scan, s.landmark_supine.rows());
+  EXPECT_EQ(given.landmarks_moved_onto_scan, 0);
+  EXPECT_TRUE(on.converged) << step_stops(on);
+  EXPECT_FALSE(given.converged) << "the draw no longer shows the fold: choose another";
+  EXPECT_LT(worst_error(on), worst_error(given) + 0.2e-3);
 }
