@@ -752,14 +752,20 @@ TEST(SimulationMesh, ACoarserMeshKeepsChestWallLandmarksAndAccuracy) {
   expect_throw_with<InputError>([&] { with_simulation_mesh(scene, -1); }, "must be positive");
 }
 
-TEST(SurfaceProjector, FlagsClosestPointsOnTheBorderOfAnOpenSurface) {
-  // Two triangles forming the unit square in z = 0: open, its four sides are border.
+namespace {
+/// Two triangles forming the square [0, side]^2 in z = 0: open, its four sides are border.
+SurfaceMesh square_in_z0(double side) {
   SurfaceMesh sq;
   sq.V.resize(4, 3);
-  sq.V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  sq.V << 0, 0, 0, side, 0, 0, side, side, 0, 0, side, 0;
   sq.F.resize(2, 3);
   sq.F << 0, 1, 2, 0, 2, 3;
-  const auto open = make_mesh_projector(sq);
+  return sq;
+}
+}  // namespace
+
+TEST(SurfaceProjector, FlagsClosestPointsOnTheBorderOfAnOpenSurface) {
+  const auto open = make_mesh_projector(square_in_z0(1.0));
   EXPECT_FALSE(open->project(Vec3(0.5, 0.4, 0.3)).on_boundary);  // above the inside
   EXPECT_FALSE(open->project(Vec3(0.5, 0.5, 0.1)).on_boundary);  // above the shared diagonal
   EXPECT_TRUE(open->project(Vec3(1.5, 0.5, 0.1)).on_boundary);   // beyond a side
@@ -773,12 +779,7 @@ TEST(SurfaceStep, LandmarksOnTheScanTakeTheirDepthFromItAndKeepWhatItDoesNotHold
   // A 10 cm square scan in z = 0 (metres). A landmark 2 mm above its inside is moved onto it,
   // with the normal there; one beyond max_projection_distance and one past its border (a skin
   // vertex would not be held there either) are kept as given, with a zero normal.
-  SurfaceMesh sq;
-  sq.V.resize(4, 3);
-  sq.V << 0, 0, 0, 0.1, 0, 0, 0.1, 0.1, 0, 0, 0.1, 0;
-  sq.F.resize(2, 3);
-  sq.F << 0, 1, 2, 0, 2, 3;
-  const auto scan = make_mesh_projector(sq);
+  const auto scan = make_mesh_projector(square_in_z0(0.1));
   SurfaceStepOptions o;
   Points t(3, 3);
   t << 0.03, 0.04, 0.002,   // above the inside
