@@ -75,8 +75,9 @@ struct SurfaceStepOptions {
   /// skin markers: the scan says how deep the skin lies, the landmark where along the surface.
   /// Taken as given, a landmark's localisation noise along the normal (1.5 mm) pits its spring
   /// against the skin springs around it, and on soft tissue the skin there folded and flipped
-  /// between two states at every projection (3 of 8 sampled re-registrations stalled on SfePy's
-  /// fat 1000 Pa body with landmark and depth noise: BENCHMARKS.md, "Landmarks on the scan").
+  /// between two states at every projection: with 1.5 mm of landmark and 1 mm of depth noise,
+  /// 6 of 16 registrations of SfePy's fat 1000 Pa body stalled (0 of 16 with this on, the same
+  /// mean error; BENCHMARKS.md, "Landmarks on the scan").
   bool landmarks_on_scan = true;
   /// Projections onto the border of an open supine surface (the edge of a depth scan, the
   /// rim of a hole behind an occlusion) are dropped: that skin is not in the scan.
@@ -134,8 +135,9 @@ struct PosePoints {
 /// Landmark targets as the pose-free surface step takes them (SurfaceStepOptions::
 /// landmarks_on_scan): a target whose projection onto `supine` holds_projection is replaced by
 /// that closest point, with the surface's unit normal there; any other target is kept as given,
-/// with a zero normal. Targets and surface in one frame. Only the tangential motion of a moved
-/// target moves it (to first order): what the linearised uncertainty takes of the landmarks.
+/// with a zero normal. Targets and surface in one frame. To first order a moved target follows
+/// its landmark along the surface only, and the surface's own depth noise along the normal: what
+/// the linearised uncertainty takes (FreePoseLinearisation::landmark_normals).
 struct LandmarksOnScan {
   Points targets;   ///< one row per target
   Points normals;   ///< the surface's unit normal at the moved target; zero: kept as given
