@@ -48,4 +48,22 @@ StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youn
   return w;
 }
 
+bool close_stiffness_bracket(std::array<std::pair<double, double>, 3>& bracket, int max_halvings,
+                             const std::function<double(double)>& misfit_at) {
+  for (const size_t side : {size_t(0), size_t(2)})
+    for (int h = 0; h < max_halvings && !std::isfinite(bracket[side].second); ++h) {
+      const double u = 0.5 * (bracket[side].first + bracket[1].first);
+      const double m = misfit_at(u);
+      if (!std::isfinite(m)) {
+        bracket[side].first = u;
+      } else if (m < bracket[1].second) {
+        bracket[2 - side] = bracket[1];
+        bracket[1] = {u, m};
+      } else {
+        bracket[side] = {u, m};
+      }
+    }
+  return std::isfinite(bracket[0].second) && std::isfinite(bracket[2].second);
+}
+
 }  // namespace btr

@@ -1,6 +1,7 @@
 #include "breast_tumour_registration/registration/stiffness_step.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -210,6 +211,22 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
                {grid_u[best - 1], grid[best - 1].misfit}};
   }
   std::sort(bracket.begin(), bracket.end());
+  // A bracket end that could not be simulated moves halfway towards the best point
+  // (close_stiffness_bracket), which may become the best.
+  if (!est.at_bound) {
+    std::array<std::pair<double, double>, 3> closed{bracket[0], bracket[1], bracket[2]};
+    std::vector<std::pair<double, Candidate>> halfway;
+    close_stiffness_bracket(closed, opt.max_end_halvings, [&](double u) {
+      halfway.emplace_back(u, evaluate(std::exp(u)));
+      return halfway.back().second.misfit;
+    });
+    for (auto& [u, c] : halfway)
+      if (u == closed[1].first) {
+        u_best = u;
+        c_best = std::move(c);
+      }
+    bracket.assign(closed.begin(), closed.end());
+  }
   if (est.at_bound) {
     est.stop_reason = "the best misfit is at the end of the range (" + pascal(std::exp(u_best)) +
                       "): the estimate is a bound; widen the range";

@@ -950,6 +950,55 @@ TEST(SurfaceStep, OptionsOutOfRangeAreNamed) {
 }
 
 // The stiffness search's grid walk on misfits known in closed form (stiffness_grid_walk.h).
+TEST(Stiffness, ABracketEndThatCannotBeSimulatedIsHalvedTowardsTheBest) {
+  // A misfit |u - u*| in ln E that cannot be simulated below u_fail (too soft to unload).
+  const double inf = std::numeric_limits<double>::infinity();
+  auto misfit_with = [&](double u_star, double u_fail, std::vector<double>& calls) {
+    return [=, &calls](double u) {
+      calls.push_back(u);
+      return u < u_fail ? inf : std::abs(u - u_star);
+    };
+  };
+  using Bracket = std::array<std::pair<double, double>, 3>;
+  std::vector<double> calls;
+  // The halfway point fits worse than the best: it closes the bracket in one call.
+  Bracket b{{{0.0, inf}, {4.0, 0.5}, {8.0, 3.5}}};
+  EXPECT_TRUE(close_stiffness_bracket(b, 3, misfit_with(4.5, 1.0, calls)));
+  EXPECT_EQ(calls, std::vector<double>({2.0}));
+  EXPECT_EQ(b[0], std::make_pair(2.0, 2.5));
+  EXPECT_EQ(b[1], std::make_pair(4.0, 0.5));
+  // It fails too, then the next halfway point closes it.
+  calls.clear();
+  b = {{{0.0, inf}, {4.0, 0.5}, {8.0, 3.5}}};
+  EXPECT_TRUE(close_stiffness_bracket(b, 3, misfit_with(4.5, 2.5, calls)));
+  EXPECT_EQ(calls, std::vector<double>({2.0, 3.0}));
+  EXPECT_EQ(b[0], std::make_pair(3.0, 1.5));
+  // The minimum lies past the halfway point: it becomes the best, the old best the stiff end,
+  // and the soft end is still closed.
+  calls.clear();
+  b = {{{0.0, inf}, {4.0, 1.5}, {8.0, 5.5}}};
+  EXPECT_TRUE(close_stiffness_bracket(b, 3, misfit_with(2.5, 1.5, calls)));
+  EXPECT_EQ(calls, std::vector<double>({2.0, 1.0, 1.5}));
+  EXPECT_EQ(b[0], std::make_pair(1.5, 1.0));
+  EXPECT_EQ(b[1], std::make_pair(2.0, 0.5));
+  EXPECT_EQ(b[2], std::make_pair(4.0, 1.5));
+  // The stiff end too; every end failing within the budget is reported, the grid point kept.
+  calls.clear();
+  b = {{{0.0, 4.5}, {4.0, 0.5}, {8.0, inf}}};
+  EXPECT_TRUE(close_stiffness_bracket(b, 3, [&](double u) { calls.push_back(u); return u > 7.0 ? inf : std::abs(u - 4.5); }));
+  EXPECT_EQ(b[2], std::make_pair(6.0, 1.5));
+  calls.clear();
+  b = {{{0.0, inf}, {4.0, 0.5}, {8.0, 3.5}}};
+  EXPECT_FALSE(close_stiffness_bracket(b, 2, misfit_with(4.5, 3.9, calls)));
+  EXPECT_EQ(calls, std::vector<double>({2.0, 3.0}));
+  EXPECT_EQ(b[0].first, 3.0);
+  EXPECT_FALSE(std::isfinite(b[0].second));
+  calls.clear();
+  b = {{{0.0, inf}, {4.0, 0.5}, {8.0, 3.5}}};
+  EXPECT_FALSE(close_stiffness_bracket(b, 0, misfit_with(4.5, 1.0, calls)));
+  EXPECT_TRUE(calls.empty());
+}
+
 TEST(Stiffness, TheGridWalkStopsPastTheMinimumAndSparesTheSoftEnd) {
   const double lo = 150, hi = 24000;
   const int n = 8;

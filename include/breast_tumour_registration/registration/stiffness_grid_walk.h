@@ -16,7 +16,9 @@
 // estimated at 3747 instead of 3578 Pa).
 #pragma once
 
+#include <array>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace btr {
@@ -36,5 +38,16 @@ std::vector<double> stiffness_grid(double min_youngs_modulus, double max_youngs_
 /// 0 < min < max / 1.5 or fewer than 3 grid points.
 StiffnessGridWalk walk_stiffness_grid(double min_youngs_modulus, double max_youngs_modulus, int grid_points,
                                       const std::function<double(double)>& misfit_at);
+
+/// Before the refinement: a bracket (ln E, misfit), ln E ascending, about its best point [1],
+/// whose end could not be simulated (a misfit that is not finite: a neighbour too soft to unload,
+/// a forward solve that failed). Each such end moves halfway towards the best point, calling
+/// misfit_at there, up to max_halvings times per side: a point that still fails becomes the
+/// end, one that fits worse than the best closes the bracket, and one that fits better becomes
+/// the best (the old best the other end) with the failed end still to close. Before this the
+/// search kept the grid point unrefined (not converged): 4 of 64 sampled re-registrations on
+/// SfePy's bodies. Returns whether both ends are finite.
+bool close_stiffness_bracket(std::array<std::pair<double, double>, 3>& bracket, int max_halvings,
+                             const std::function<double(double)>& misfit_at);
 
 }  // namespace btr

@@ -33,6 +33,10 @@ struct StiffnessOptions {
   int grid_points = 8;                ///< log-spaced over the range
   double relative_tolerance = 0.05;   ///< refinement stops when a step changes E by less than this
   int max_refinements = 6;
+  /// A neighbour of the best grid point that cannot be simulated (too soft to unload, a forward
+  /// solve that fails) is replaced by the point halfway to the best one, up to this many times
+  /// per side, before the grid point is kept unrefined (not converged).
+  int max_end_halvings = 3;
   /// [m] A candidate's unload stops once re-simulating reproduces the prone shape within this
   /// (or unload.tolerance, if larger); only the chosen candidate is then finished to
   /// unload.tolerance. The misfit moves by about this much, far less than between candidates.
