@@ -10,7 +10,8 @@
 // the supine landmarks after their best rigid fit (Kabsch), so it does not depend on the pose.
 // The search is a log-spaced grid from the stiff end, stopped once the misfit has clearly
 // passed its minimum (the soft candidates are the costly ones; stiffness_grid_walk.h), then
-// parabolic refinement in log E around the best point. Equilibrium is invariant under scaling E and gravity together,
+// parabolic refinement in log E around the best point (a neighbour too soft to simulate is
+// first halved towards it: close_stiffness_bracket). Equilibrium is invariant under scaling E and gravity together,
 // so a candidate is simulated with the gravities divided by the factor.
 #pragma once
 
