@@ -511,29 +511,27 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
         u.d_gravity_tilt[k] = R_out * Vec3(-lambda.transpose() * b_g[k]);
         cov_g += sd_theta * sd_theta * u.d_gravity_tilt[k] * u.d_gravity_tilt[k].transpose();
       }
-    // Depth noise: the held target of vertex v moves by delta along n, dG_v/d delta = -spring n
-    // (model frame; A n = spring n).
-    Mat3 cov_d = Mat3::Zero();
-    for (const HeldSkinVertex& h : held) {
-      const int f = H.free_index(h.vertex);
-      Vec3 d = Vec3::Zero();
-      if (f >= 0) d = spring * lambda.middleRows<3>(3 * f).transpose() * h.normal;
-      if (free_pose)  // lambda is the projector frame's adjoint already; the pose moves too
-        d += spring * G_pose * pose_jacobian(P * Vec3(x.row(h.vertex).transpose())).transpose() * (Q * h.normal);
-      d = R_out * d;
-      cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
-    }
-    // The landmarks sharing a free pose, A = w I: the output's motion (supine frame) when target
-    // i moves by `moved` (projector frame).
-    auto target_response = [&](size_t i, const Vec3& moved) {
-      const Anchor& a = pose_anchors[i];
-      Vec3 local = Vec3::Zero();  // lambda^T B_i^T Q^T moved (projector frame, as lambda is)
+    // The output's motion (supine frame) when the target of anchor a's spring moves by `moved`
+    // (projector frame), where its metric A gives A moved = weight moved (an isotropic spring, or
+    // a held skin spring moved along its normal): the local pull lambda^T B^T Q^T A moved (lambda
+    // is the projector frame's adjoint with a free pose) and, with a free pose, the pose's motion
+    // (G_pose; zero, and Q, P the identity, with a held one).
+    auto target_response = [&](const Anchor& a, double weight, const Vec3& moved) {
+      Vec3 local = Vec3::Zero();
       for (int k = 0; k < a.count; ++k) {
         const int f = H.free_index(a.v[k]);
         if (f >= 0) local += a.w[k] * lambda.middleRows<3>(3 * f).transpose() * (Q.transpose() * moved);
       }
-      return Vec3(R_out * (free_pose->landmark_weight * (local + G_pose * pose_jacobian(P * a.position(x)).transpose() * moved)));
+      return Vec3(R_out * (weight * (local + G_pose * pose_jacobian(P * a.position(x)).transpose() * moved)));
     };
+    // Depth noise: the held target of vertex v moves by delta along n, A n = spring n.
+    Mat3 cov_d = Mat3::Zero();
+    for (const HeldSkinVertex& h : held) {
+      const Vec3 d = target_response(Anchor::vertex(h.vertex), spring, Q * h.normal);
+      cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
+    }
+    // The landmarks sharing a free pose, A = w I.
+    const double w_landmark = free_pose ? free_pose->landmark_weight : 0.0;
     // A target the step moved onto the scan (landmarks_on_scan) follows its landmark along the
     // surface only, and the scan's depth noise there along the normal.
     const Points* normals = free_pose && free_pose->landmark_normals.rows() > 0 ? &free_pose->landmark_normals : nullptr;
@@ -541,7 +539,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
       for (size_t i = 0; i < pose_anchors.size(); ++i) {
         const Vec3 n = normals->row(static_cast<Eigen::Index>(i)).transpose();
         if (n.squaredNorm() == 0) continue;
-        const Vec3 d = target_response(i, n);
+        const Vec3 d = target_response(pose_anchors[i], w_landmark, n);
         cov_d += opt.sources.depth_noise * opt.sources.depth_noise * d * d.transpose();
       }
     Mat3 cov_l = Mat3::Zero();
@@ -555,7 +553,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
         }
         for (int d = 0; d < 3; ++d) {
           const Vec3 e = Vec3::Unit(d);
-          Vec3 dc = target_response(i, follows * e);
+          Vec3 dc = target_response(pose_anchors[i], w_landmark, follows * e);
           if (out.estimate_follows_landmarks)  // d ln E / dy, the fit in the model frame (the landmarks as given)
             dc += fit_motion.per_log_e.segment<3>(3 * static_cast<Eigen::Index>(i)).dot(Q.transpose() * e) /
                   fit_motion.per_log_e.squaredNorm() * u.d_log_youngs_modulus;
