@@ -30,6 +30,18 @@ std::string coarse_phantom_at(double e, const std::string& prefix) {
   write_phantom_scene(d, po);
   return d;
 }
+
+/// Every row of run_calibration over `scenes`: this preset, `draws` noisy copies of each scene,
+/// `samples` sampled re-registrations per copy.
+std::vector<CalibrationRow> calibration_rows(const std::vector<Scene>& scenes, const std::string& preset, int draws, int samples) {
+  CalibrationOptions o;
+  o.registration = preset_options(preset);
+  o.draws = draws;
+  o.samples = samples;
+  std::vector<CalibrationRow> rows;
+  run_calibration(scenes, o, [&](const CalibrationRow& r) { rows.push_back(r); });
+  return rows;
+}
 }  // namespace
 
 TEST(UncertaintySources, AScenesSectionOverridesTheDefaultsInSIAndBadFieldsAreNamed) {
@@ -155,12 +167,7 @@ TEST(Calibration, WithoutSourcesEveryCopyIsTheScenesOwnRegistration) {
 TEST(Calibration, TheSampledRegionHoldsTheTruthOnPhantomsOfUnknownStiffness) {
   std::vector<Scene> scenes;
   for (double e : {600.0, 1800.0}) scenes.push_back(load_scene(coarse_phantom_at(e, "E") + "/scene.yaml"));
-  CalibrationOptions o;
-  o.registration = preset_options("fast");
-  o.draws = 3;
-  o.samples = 16;
-  std::vector<CalibrationRow> rows;
-  run_calibration(scenes, o, [&](const CalibrationRow& r) { rows.push_back(r); });
+  const std::vector<CalibrationRow> rows = calibration_rows(scenes, "fast", 3, 16);
   ASSERT_EQ(rows.size(), 30u);
   const Coverage s = observed_coverage(rows, 0.95, true), l = observed_coverage(rows, 0.95, false);
   double tilt = 0;
@@ -201,12 +208,7 @@ TEST(Calibration, WithoutAChestRingTheLinearRegionHoldsTheTruthAtItsLevel) {
     scenes.push_back(load_scene(d + "/ring_free.yaml"));
     ASSERT_FALSE(scenes.back().prone_rigid);
   }
-  CalibrationOptions o;
-  o.registration = preset_options("balanced");
-  o.draws = 4;
-  o.samples = 0;
-  std::vector<CalibrationRow> rows;
-  run_calibration(scenes, o, [&](const CalibrationRow& r) { rows.push_back(r); });
+  const std::vector<CalibrationRow> rows = calibration_rows(scenes, "balanced", 4, 0);
   ASSERT_EQ(rows.size(), 40u);
   const Coverage l = observed_coverage(rows, 0.95, false);
   std::vector<double> ratio;
