@@ -302,7 +302,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       // that share it (SurfaceGuidedStep: 3 or more) are a source.
       std::optional<FreePoseLinearisation> free_pose;
       if (r.pose_solved_with_surface) {
-        free_pose = FreePoseLinearisation{to_projector, {}, Points(0, 3), opt.surface.pose_points_weight};
+        free_pose = FreePoseLinearisation{to_projector, {}, Points(0, 3), opt.surface.pose_points_weight, Points(0, 3)};
         if (targets.rows() >= 3) {
           free_pose->landmarks = scene.landmark_anchors;
           free_pose->landmark_targets = transform_points(to_projector, targets);

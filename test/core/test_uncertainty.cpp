@@ -283,7 +283,7 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
     k.point = P0.inverse() * k.point;
     k.normal = P0.linear().transpose() * k.normal;
   }
-  const FreePoseLinearisation free{P0, ps.landmark_anchors, targets, o.surface.pose_points_weight};
+  const FreePoseLinearisation free{P0, ps.landmark_anchors, targets, o.surface.pose_points_weight, Points(0, 3)};
   const UncertaintyResult lin =
       linearised_tumour_uncertainty(model, x0, held_m, T.inverse() * P0, o.surface, o.uncertainty, std::nullopt, nullptr, &free);
   const UncertaintyResult held_pose = linearised_tumour_uncertainty(model, x0, held, T.inverse(), o.surface, o.uncertainty);
@@ -327,8 +327,11 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
   EXPECT_LT(err2, 0.06 * 0.06 * fd2);
   // The free pose is a visible part of the response, and the landmarks a named source.
   EXPECT_GT(pose_part, 0.1);
-  for (const auto& [name, cov] : lin.tumours[0].sources)
-    if (name == "landmarks") EXPECT_GT(cov.trace(), 0);
+  for (const auto& [name, cov] : lin.tumours[0].sources) {
+    if (name == "landmarks") {
+      EXPECT_GT(cov.trace(), 0);
+    }
+  }
   EXPECT_EQ(lin.tumours[0].sources.back().first, "landmarks");
   // Landmarks moved onto the scan first (SurfaceStepOptions::landmarks_on_scan), as the surface
   // step takes them. Only their motion along the surface moves the tumours, and the
@@ -365,8 +368,7 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
     k.point = P_on.inverse() * k.point;
     k.normal = P_on.linear().transpose() * k.normal;
   }
-  FreePoseLinearisation free_on{P_on, ps.landmark_anchors, on.targets, o.surface.pose_points_weight};
-  free_on.landmark_normals = on.normals;
+  const FreePoseLinearisation free_on{P_on, ps.landmark_anchors, on.targets, o.surface.pose_points_weight, on.normals};
   const UncertaintyResult lin_on = linearised_tumour_uncertainty(model, x_on, held_on, T.inverse() * P_on, o.surface,
                                                                  o.uncertainty, std::nullopt, nullptr, &free_on);
   // The control: the targets themselves moved, linearised without the normals. Its difference
