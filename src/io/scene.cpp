@@ -44,7 +44,7 @@ const std::vector<std::string> kSceneKeys = {
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmarks.prone", "landmarks.supine", "patient_frame", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.denoise", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
-    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "material.nodal_element_share", "regions", "regions[]",
+    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "material.nodal_element_share", "material.nodal_fallback", "regions", "regions[]",
     "regions[].name", "regions[].youngs_modulus", "regions[].relative_stiffness", "regions[].label", "regions[].surface", "prone.cell_labels", "tumour_material",
     "tumour_material.youngs_modulus", "gravity", "prone_gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
     "misalignment.translation_mm", "uncertainty", "uncertainty.youngs_modulus_range", "uncertainty.poisson_ratio_range",
@@ -307,6 +307,7 @@ Scene load_scene_fields(const std::string& path) {
         s.material.volume_form = parse_volume_form(c.text(m["volume_form"], "material.volume_form"));
         return 0;
       });
+    if (m["nodal_fallback"]) s.nodal_fallback = c.boolean(m["nodal_fallback"], "material.nodal_fallback");
     if (m["nodal_element_share"]) {
       s.material.nodal_element_share = c.number(m["nodal_element_share"], "material.nodal_element_share");
       if (!(s.material.nodal_element_share >= 0) || !std::isfinite(s.material.nodal_element_share))

@@ -117,11 +117,46 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
 
 const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt) { return entry(opt).prepared; }
 
+RegistrationEngine::Entry& RegistrationEngine::element_entry(Entry& e, double& seconds) {
+  seconds = 0;
+  if (e.element) return *e.element;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto f = std::make_unique<Entry>();
+  PreparedScene& p = f->prepared;
+  p.scene = e.prepared.scene;  // the same simulation mesh, materials, regions and rest-shape plan
+  p.scene.material.volume_form = VolumeForm::Element;
+  p.mesh_note = e.prepared.mesh_note;
+  p.mesh_seconds = e.prepared.mesh_seconds;
+  p.model = prepare_model(p.scene, p.warnings, unload_, &f->solvers);
+  p.prepare_seconds = since(t0);
+  seconds = p.prepare_seconds;
+  e.element = std::move(f);
+  return *e.element;
+}
+
 RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const RegistrationOptions& opt,
                                            const StepCallback& callback) {
   RegistrationResult r = run_registration(supine, e.prepared.model, opt, callback, &e.solvers);
   r.warnings.insert(r.warnings.begin(), e.prepared.warnings.begin(), e.prepared.warnings.end());
-  return r;
+  if (r.converged || r.volume_form != VolumeForm::Nodal || !supine.nodal_fallback) return r;
+  // The nodal form did not converge (on coarse soft meshes it folds where the element form's
+  // locking holds the mesh together): the element form on the same mesh, from the start.
+  RegistrationResult::VolumeFormFallback why;
+  for (const auto& rep : r.reports)
+    if (!rep.converged) why.nodal_stop += (why.nodal_stop.empty() ? "" : "; ") + rep.name + ": " + rep.stop_reason;
+  why.nodal_seconds = r.seconds;
+  Entry& f = element_entry(e, why.prepare_seconds);
+  Scene s = supine;
+  s.material.volume_form = VolumeForm::Element;
+  RegistrationResult fr = run_registration(s, f.prepared.model, opt, callback, &f.solvers);
+  fr.warnings.insert(fr.warnings.begin(), f.prepared.warnings.begin(), f.prepared.warnings.end());
+  fr.warnings.push_back("the nodal volume form did not converge (" + why.nodal_stop +
+                        "); registered again with the element form, which " +
+                        (fr.converged ? "converged" : "did not converge either") +
+                        ": this is its result (material.nodal_fallback: false keeps the nodal one)");
+  fr.seconds += why.nodal_seconds + why.prepare_seconds;
+  fr.volume_form_fallback = std::move(why);
+  return fr;
 }
 
 RegistrationResult RegistrationEngine::solve(const RegistrationOptions& opt, const StepCallback& callback) {
@@ -160,7 +195,7 @@ Scene RegistrationEngine::live_call(const Entry& e, const LiveScan& scan, const 
 
 SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources,
                                                          int samples, unsigned seed, const RegistrationResult& nominal) {
-  Entry& e = entry(opt);
+  Entry& e = nominal_entry(entry(opt), nominal);
   Scene s = e.prepared.scene;
   s.preset = opt.preset;
   return sample(e, s, opt, sources, samples, seed, nominal);
@@ -169,7 +204,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
 SampledUncertainty RegistrationEngine::sample_uncertainty_live(const LiveScan& scan, const LiveSceneOptions& live,
                                                               RegistrationOptions opt, const UncertaintyOptions& sources,
                                                               int samples, unsigned seed, const RegistrationResult& nominal) {
-  Entry& e = entry(opt);
+  Entry& e = nominal_entry(entry(opt), nominal);
   const Scene s = live_call(e, scan, live, opt);
   return sample(e, s, opt, sources, samples, seed, nominal);
 }
@@ -297,15 +332,21 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   return out;
 }
 
+RegistrationEngine::Entry& RegistrationEngine::nominal_entry(Entry& e, const RegistrationResult& nominal) {
+  if (!nominal.volume_form_fallback) return e;
+  double seconds = 0;
+  return element_entry(e, seconds);
+}
+
 int RegistrationEngine::solvers_built() const {
   int n = 0;
-  for (const auto& [k, e] : entries_) n += e->solvers.built();
+  for (const auto& [k, e] : entries_) n += e->solvers.built() + (e->element ? e->element->solvers.built() : 0);
   return n;
 }
 
 int RegistrationEngine::solvers_reused() const {
   int n = 0;
-  for (const auto& [k, e] : entries_) n += e->solvers.reused();
+  for (const auto& [k, e] : entries_) n += e->solvers.reused() + (e->element ? e->element->solvers.reused() : 0);
   return n;
 }
 

@@ -214,6 +214,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
   const Rigid to_projector = c.to_projector;
   const Points& targets = c.targets;
   r.supine_to_model = T;
+  r.volume_form = model.volume_form;
   for (const auto& rep : r.reports) {
     r.converged = r.converged && rep.converged;
     if (!rep.note.empty()) r.warnings.push_back(rep.name + " step: " + rep.note);

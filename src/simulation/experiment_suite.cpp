@@ -282,6 +282,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           Scene scene = experiment_scene(model, conf, *run, opt.preset, opt.rest_shape);
           scene.material.volume_form = opt.method_volume_form;
           scene.material.nodal_element_share = opt.method_nodal_element_share;
+          scene.nodal_fallback = opt.method_nodal_fallback;
           if (opt.simulation_cell_size > 0) scene = with_simulation_mesh(scene, opt.simulation_cell_size);
           std::vector<std::string> warnings;
           // The unloaded shape depends on the configuration and the method's material only:
@@ -315,6 +316,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
             for (const auto& rep : r.reports)
               if (!rep.converged) status += ": " + rep.name + ": " + rep.stop_reason;
           }
+          if (r.volume_form_fallback) status += " (element form: the nodal did not converge)";
           if (r.implausible) status += " (implausible)";
           for (const auto& t : r.tumours) {
             row.tumour = t.name;

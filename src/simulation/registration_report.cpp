@@ -137,9 +137,14 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   j["materials"] = materials;
   // Which material model ran: the volume term's form (resolved from the scene's `auto`) and
   // Poisson's ratio, which set how far the same E lets the tissue sag.
-  j["material_model"] = {{"volume_form", to_string(model.volume_form)}, {"poisson_ratio", num(model.material.poisson_ratio)}};
-  if (model.volume_form == VolumeForm::Nodal)
+  // Where the nodal form did not converge and the engine fell back, the element form's.
+  j["material_model"] = {{"volume_form", to_string(r.volume_form)}, {"poisson_ratio", num(model.material.poisson_ratio)}};
+  if (r.volume_form == VolumeForm::Nodal)
     j["material_model"]["nodal_element_share"] = num(model.material.nodal_element_share);
+  if (const auto& f = r.volume_form_fallback)
+    j["material_model"]["fallback_from_nodal"] = {{"nodal_stop", f->nodal_stop},
+                                                  {"nodal_seconds", num(f->nodal_seconds)},
+                                                  {"element_prepare_seconds", num(f->prepare_seconds)}};
   if (r.steps.stiffness) {
     Json evaluations = Json::array();
     for (const auto& [E, misfit] : r.stiffness_evaluations)

@@ -61,6 +61,12 @@ int main(int argc, char** argv) {
                  "change, in units of its shear modulus (material.nodal_element_share)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  std::string nodal_fallback = "on";
+  app.add_option("--nodal-fallback", nodal_fallback,
+                 "with the nodal volume term: a run that ends not converged is run again with the element form "
+                 "(material.nodal_fallback)")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
   app.add_option("--cell-size", cell_mm, "built-in phantom: tetrahedron size bound [mm] (8: ~6k tets, 4.7: ~35k)")
       ->capture_default_str();
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
@@ -103,6 +109,7 @@ int main(int argc, char** argv) {
     opt.simulation_cell_size = simulation_cell_mm * 1e-3;
     opt.method_volume_form = parse_volume_form(volume_form);
     opt.method_nodal_element_share = nodal_element_share;
+    opt.method_nodal_fallback = nodal_fallback == "on";
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};
     preset_options(preset);  // validates the name before the expensive steps
     const std::vector<ExperimentRun> runs = plan_experiments(opt);

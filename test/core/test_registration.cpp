@@ -504,6 +504,10 @@ TEST(SceneErrors, NameTheFieldAtFault) {
       [&] { load_meshed_scene(scene_with("material: {volume_form: nodal, nodal_element_share: -1}", "bad_share")); },
       "field 'material.nodal_element_share': must be >= 0");
   EXPECT_EQ(load_meshed_scene(scene_with("material: {volume_form: nodal, nodal_element_share: 5}", "share")).material.nodal_element_share, 5);
+  EXPECT_TRUE(load_meshed_scene(scene_with("material: {volume_form: nodal}", "fallback")).nodal_fallback);
+  EXPECT_FALSE(load_meshed_scene(scene_with("material: {volume_form: nodal, nodal_fallback: false}", "no_fallback")).nodal_fallback);
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("material: {nodal_fallback: sometimes}", "bad_fallback")); },
+                                "field 'material.nodal_fallback'");
   btr::test::write_text(phantom_dir() + "/bad_landmarks.csv", "prone_index,supine_index\n99999,1\n");
   expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("landmarks: bad_landmarks.csv", "bad_lm")); }, "field 'landmarks'");
 }

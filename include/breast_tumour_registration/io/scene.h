@@ -90,6 +90,10 @@ struct Scene {
   std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
   std::vector<SceneTumour> tumours;
   MaterialParameters material;
+  /// `material.nodal_fallback` (default true): a registration with the nodal volume form that
+  /// ends not converged is run again with the element form, and that result is returned
+  /// (RegistrationEngine; RegistrationResult::volume_form_fallback says why)
+  bool nodal_fallback = true;
   std::vector<MaterialRegion> regions;   ///< per-element materials, in order (later wins)
   std::vector<int> prone_labels;         ///< cell label per prone tetrahedron, when a region selects by label
   std::optional<double> tumour_youngs_modulus;

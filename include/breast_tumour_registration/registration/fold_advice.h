@@ -13,6 +13,7 @@ namespace btr {
 
 /// The advice for `model` after `reports`, or empty: only with the nodal volume form, and only
 /// when a step ended not converged with tetrahedra inverted or a fold named in its stop reason.
+/// A user reads it where the scene turned the engine's fallback to the element form off.
 std::string fold_advice(const RegistrationModel& model, const std::vector<StepReport>& reports);
 
 }  // namespace btr

@@ -49,6 +49,11 @@ class RegistrationEngine {
   const PreparedScene& prepare(const RegistrationOptions& opt);
 
   /// Registers the scene's own supine side. The result's warnings start with the preparation's.
+  /// Every solve (not the samples' re-registrations) with the nodal volume form that ends not
+  /// converged is run again with the element form on the same mesh where the scene allows it
+  /// (Scene::nodal_fallback, the default), and the element form's result is returned with
+  /// RegistrationResult::volume_form_fallback set and a warning: on coarse soft meshes the nodal
+  /// form folds where the element form holds (BENCHMARKS.md, "The fallback to the element form").
   RegistrationResult solve(const RegistrationOptions& opt, const StepCallback& callback = {});
   /// Registers `supine` (this engine's scene, or a copy whose supine side, landmarks' supine
   /// positions, ground truth or steps were replaced) on the prepared prone side; InputError when
@@ -65,7 +70,8 @@ class RegistrationEngine {
   /// solvers; `nominal` is this engine's solve(opt). On an unloaded model every sample that
   /// draws a material estimates the unloaded shape again. E is not sampled where the scene
   /// estimates it (the stiffness step does, from the sampled landmarks), and the noise not on a
-  /// point cloud; the note says so.
+  /// point cloud; the note says so. The samples use the volume form `nominal` was computed
+  /// with (the element form where it fell back) and do not fall back one by one.
   SampledUncertainty sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources, int samples,
                                         unsigned seed, const RegistrationResult& nominal);
 
@@ -83,8 +89,15 @@ class RegistrationEngine {
   struct Entry {
     PreparedScene prepared;
     StepSolvers solvers;
+    /// With the nodal volume form: the same mesh prepared with the element form, made when a
+    /// registration first falls back to it (its own unloaded shape and solvers)
+    std::unique_ptr<Entry> element;
   };
   Entry& entry(const RegistrationOptions& opt);
+  /// e's element-form twin, prepared on first use (`seconds`: the time that took, else 0)
+  Entry& element_entry(Entry& e, double& seconds);
+  /// The entry `nominal` was computed on: e, or its element-form twin where it fell back
+  Entry& nominal_entry(Entry& e, const RegistrationResult& nominal);
   RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);
   /// The scene of a live scan on `e`'s prepared scene; `opt` takes the tracked pose it decides
   /// and that pose's covariance (solve_live and sample_uncertainty_live alike).

@@ -144,6 +144,16 @@ struct RegistrationResult {
   /// empty: not estimated): StiffnessEstimate::supine_prediction
   Points stiffness_prediction;
   std::vector<StepReport> reports;
+  /// The volume term the result was computed with (the model's, resolved from `auto`)
+  VolumeForm volume_form = VolumeForm::Element;
+  /// Set where a registration with the nodal form ended not converged and the engine registered
+  /// again with the element form (Scene::nodal_fallback): this result is the element form's.
+  struct VolumeFormFallback {
+    std::string nodal_stop;      ///< the nodal attempt's unconverged steps and their stop reasons
+    double nodal_seconds = 0;    ///< its registration time [s] (in `seconds`)
+    double prepare_seconds = 0;  ///< preparing the element form's model (first fallback only; in `seconds`)
+  };
+  std::optional<VolumeFormFallback> volume_form_fallback;
   /// [m] the supine mesh's estimated noise along its normals (0: not estimated: no mesh, or
   /// denoising off), and whether the surface step projected onto it denoised
   double supine_noise = 0;

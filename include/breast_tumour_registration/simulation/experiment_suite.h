@@ -55,6 +55,9 @@ struct ExperimentSuiteOptions {
   /// The method's volume term (the generating material keeps its own: simulate_phantom).
   VolumeForm method_volume_form = VolumeForm::Auto;
   double method_nodal_element_share = 0;  ///< the method's MaterialParameters::nodal_element_share
+  /// The method's Scene::nodal_fallback: a nodal run that ends not converged is run again with
+  /// the element form (its status then ends in " (element form: the nodal did not converge)")
+  bool method_nodal_fallback = true;
   /// > 0 [m]: every run's prone model is re-tetrahedralized from its boundary at this size
   /// (with_simulation_mesh), as btr_register meshes a prone surface; 0: the model's own mesh
   /// (with given configurations, the mesh their truth was computed on).
