@@ -103,13 +103,7 @@ TEST(Engine, AnAdoptedModelIsSolvedAsGivenWhateverThePresetsMesh) {
 // 400 Pa, the thesis's method (3400 Pa, prone shape as rest) on a scan shifted 10 mm along z
 // without the rigid step, a run the experiment suite's nodal form does not converge.
 TEST(Engine, ANodalRegistrationThatDoesNotConvergeFallsBackToTheElementForm) {
-  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12_400_fallback").string();
-  std::filesystem::remove_all(d);
-  PhantomSceneOptions o;
-  o.phantom.tet.cell_size = 0.012;
-  o.phantom.surface_rings = 12;
-  o.youngs_modulus = 400;
-  write_phantom_scene(d, o);
+  const std::string d = btr::test::write_coarse_phantom("phantom12_400_fallback", 400);
   Scene s = load_meshed_scene(d + "/scene.yaml");
   s.steps = {"landmarks", "surface"};
   apply_misalignment(s, misalignment_from_degrees_mm(Vec3::Zero(), Vec3(0, 0, 10)));

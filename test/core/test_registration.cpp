@@ -58,16 +58,7 @@ std::string scene_with(const std::string& extra, const std::string& name, const 
 }
 
 // A coarse phantom scene whose truth our FEM made at 600 Pa (a soft breast), in its own folder.
-std::string soft_phantom_dir(const std::string& name) {
-  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / name).string();
-  std::filesystem::remove_all(d);
-  PhantomSceneOptions o;
-  o.phantom.tet.cell_size = 0.012;
-  o.phantom.surface_rings = 12;
-  o.youngs_modulus = 600;
-  write_phantom_scene(d, o);
-  return d;
-}
+std::string soft_phantom_dir(const std::string& name) { return btr::test::write_coarse_phantom(name, 600); }
 
 RegistrationResult register_scene(const std::string& path, const RegistrationOptions& options) {
   const Scene s = load_meshed_scene(path);

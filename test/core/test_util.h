@@ -28,19 +28,24 @@ inline std::string temp_dir() {
   return dir.string();
 }
 
-/// One coarse phantom scene (12 mm cells, 12 surface rings, E = 3400 Pa, 2.2k tetrahedra),
-/// written once per test process and loaded; shared by the tests that only read it.
+/// A coarse phantom scene (12 mm cells, 12 surface rings, 2.2k tetrahedra) whose truth our FEM
+/// made at `youngs_modulus` [Pa], written afresh into its own temporary folder `name`.
+inline std::string write_coarse_phantom(const std::string& name, double youngs_modulus) {
+  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / name).string();
+  std::filesystem::remove_all(d);
+  PhantomSceneOptions o;
+  o.phantom.tet.cell_size = 0.012;
+  o.phantom.surface_rings = 12;
+  o.youngs_modulus = youngs_modulus;
+  write_phantom_scene(d, o);
+  return d;
+}
+
+/// One coarse phantom scene (write_coarse_phantom, E = 3400 Pa), written once per test process
+/// and loaded; shared by the tests that only read it.
 /// Its folder (tests may add scene variants beside scene.yaml, never change it) and the scene.
 inline const std::string& coarse_phantom_dir() {
-  static const std::string dir = [] {
-    const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom12").string();
-    std::filesystem::remove_all(d);
-    PhantomSceneOptions o;
-    o.phantom.tet.cell_size = 0.012;
-    o.phantom.surface_rings = 12;
-    write_phantom_scene(d, o);
-    return d;
-  }();
+  static const std::string dir = write_coarse_phantom("phantom12", 3400);
   return dir;
 }
 
