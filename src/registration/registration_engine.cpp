@@ -231,6 +231,8 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   std::map<std::string, int> stops, failures;  // why samples did not converge, or failed
   if (src.samples_youngs_modulus() && estimates_e)
     notes.push_back("E not sampled: the stiffness step estimates it from the (sampled) landmarks in every sample");
+  if (nominal.volume_form_fallback)
+    notes.push_back("sampled with the element volume form, which the nominal registration fell back to");
   const bool sample_noise = src.depth_noise > 0 && scene.supine_surface;
   if (src.depth_noise > 0 && !scene.supine_surface) notes.push_back("depth noise not sampled on a point cloud");
   // The camera that sees the skin sees the rigid region too: its noise moves the pose ICP fits.

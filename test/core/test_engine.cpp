@@ -155,6 +155,7 @@ TEST(Engine, ANodalRegistrationThatDoesNotConvergeFallsBackToTheElementForm) {
   RegistrationEngine element_engine(element);
   const SampledUncertainty se = element_engine.sample_uncertainty(opt, sources, 2, 1, element_engine.solve(opt));
   ASSERT_EQ(su.samples, 2) << su.note;
+  EXPECT_NE(su.note.find("sampled with the element volume form"), std::string::npos) << su.note;
   ASSERT_EQ(su.tumours.size(), se.tumours.size());
   for (size_t i = 0; i < su.tumours.size(); ++i) {
     ASSERT_EQ(su.tumours[i].centroids.size(), se.tumours[i].centroids.size());
