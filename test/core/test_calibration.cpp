@@ -22,13 +22,7 @@ namespace {
 /// A coarse phantom (12 mm cells, 12 surface rings) generated at Young's modulus e, in a fresh
 /// folder named prefix + e; returns the folder.
 std::string coarse_phantom_at(double e, const std::string& prefix) {
-  const std::string d = btr::test::temp_dir() + "/" + prefix + std::to_string(static_cast<int>(e));
-  PhantomSceneOptions po;
-  po.phantom.tet.cell_size = 0.012;
-  po.phantom.surface_rings = 12;
-  po.youngs_modulus = e;
-  write_phantom_scene(d, po);
-  return d;
+  return btr::test::write_coarse_phantom_in(btr::test::temp_dir() + "/" + prefix + std::to_string(static_cast<int>(e)), e);
 }
 
 /// Every row of run_calibration over `scenes`: this preset, `draws` noisy copies of each scene,

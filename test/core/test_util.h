@@ -29,9 +29,8 @@ inline std::string temp_dir() {
 }
 
 /// A coarse phantom scene (12 mm cells, 12 surface rings, 2.2k tetrahedra) whose truth our FEM
-/// made at `youngs_modulus` [Pa], written afresh into its own temporary folder `name`.
-inline std::string write_coarse_phantom(const std::string& name, double youngs_modulus) {
-  const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / name).string();
+/// made at `youngs_modulus` [Pa], written afresh into folder `d`; returns d.
+inline std::string write_coarse_phantom_in(const std::string& d, double youngs_modulus) {
   std::filesystem::remove_all(d);
   PhantomSceneOptions o;
   o.phantom.tet.cell_size = 0.012;
@@ -39,6 +38,10 @@ inline std::string write_coarse_phantom(const std::string& name, double youngs_m
   o.youngs_modulus = youngs_modulus;
   write_phantom_scene(d, o);
   return d;
+}
+/// The same in the temporary folder btr_tests/`name`.
+inline std::string write_coarse_phantom(const std::string& name, double youngs_modulus) {
+  return write_coarse_phantom_in((std::filesystem::temp_directory_path() / "btr_tests" / name).string(), youngs_modulus);
 }
 
 /// One coarse phantom scene (write_coarse_phantom, E = 3400 Pa), written once per test process
