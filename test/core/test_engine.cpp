@@ -129,7 +129,7 @@ TEST(Engine, ANodalRegistrationThatDoesNotConvergeFallsBackToTheElementForm) {
   EXPECT_EQ(r.volume_form, VolumeForm::Element);
   ASSERT_TRUE(r.volume_form_fallback);
   EXPECT_FALSE(r.volume_form_fallback->nodal_stop.empty());
-  EXPECT_NEAR(r.volume_form_fallback->nodal_seconds, kept.seconds, 0.5 * kept.seconds + 0.5);
+  EXPECT_GT(r.volume_form_fallback->nodal_seconds, 0.0);
   EXPECT_GT(r.volume_form_fallback->prepare_seconds, 0.0);
   EXPECT_GE(r.seconds, r.volume_form_fallback->nodal_seconds + r.volume_form_fallback->prepare_seconds);
   EXPECT_TRUE(btr::test::has_warning(r, "registered again with the element form, which converged"));
