@@ -195,37 +195,35 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   est.at_bound = (best == 0 && grid_u[0] >= hi - 1e-12) || (best == n - 1 && grid_u[n - 1] <= lo + 1e-12);
   // At an end of the range: the point halfway (in log E) to its neighbour tells a minimum
   // just inside from one beyond the end.
-  std::vector<std::pair<double, double>> bracket;  // (u, misfit) of three points, u ascending
+  std::array<std::pair<double, double>, 3> bracket;  // (u, misfit) of three points, u ascending (not at a bound)
   if (est.at_bound && n >= 2) {
     const int nb = best == 0 ? 1 : n - 2;
     const double um = 0.5 * (grid_u[best] + grid_u[nb]);
     Candidate c = evaluate(std::exp(um));
     if (c.misfit < grid[best].misfit) {
       est.at_bound = false;
-      bracket = {{grid_u[best], grid[best].misfit}, {um, c.misfit}, {grid_u[nb], grid[nb].misfit}};
+      bracket = {{{grid_u[best], grid[best].misfit}, {um, c.misfit}, {grid_u[nb], grid[nb].misfit}}};
       u_best = um;
       c_best = std::move(c);
     }
   } else if (!est.at_bound) {
-    bracket = {{grid_u[best + 1], grid[best + 1].misfit}, {grid_u[best], grid[best].misfit},
-               {grid_u[best - 1], grid[best - 1].misfit}};
+    bracket = {{{grid_u[best + 1], grid[best + 1].misfit}, {grid_u[best], grid[best].misfit},
+                {grid_u[best - 1], grid[best - 1].misfit}}};
   }
-  std::sort(bracket.begin(), bracket.end());
   // A bracket end that could not be simulated moves halfway towards the best point
   // (close_stiffness_bracket), which may become the best.
   if (!est.at_bound) {
-    std::array<std::pair<double, double>, 3> closed{bracket[0], bracket[1], bracket[2]};
+    std::sort(bracket.begin(), bracket.end());
     std::vector<std::pair<double, Candidate>> halfway;
-    close_stiffness_bracket(closed, opt.max_end_halvings, [&](double u) {
+    close_stiffness_bracket(bracket, opt.max_end_halvings, [&](double u) {
       halfway.emplace_back(u, evaluate(std::exp(u)));
       return halfway.back().second.misfit;
     });
     for (auto& [u, c] : halfway)
-      if (u == closed[1].first) {
+      if (u == bracket[1].first) {
         u_best = u;
         c_best = std::move(c);
       }
-    bracket.assign(closed.begin(), closed.end());
   }
   if (est.at_bound) {
     est.stop_reason = "the best misfit is at the end of the range (" + pascal(std::exp(u_best)) +
