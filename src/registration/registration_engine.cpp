@@ -117,8 +117,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
 
 const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt) { return entry(opt).prepared; }
 
-RegistrationEngine::Entry& RegistrationEngine::element_entry(Entry& e, double& seconds) {
-  seconds = 0;
+RegistrationEngine::Entry& RegistrationEngine::element_entry(Entry& e) {
   if (e.element) return *e.element;
   const auto t0 = std::chrono::steady_clock::now();
   auto f = std::make_unique<Entry>();
@@ -129,7 +128,6 @@ RegistrationEngine::Entry& RegistrationEngine::element_entry(Entry& e, double& s
   p.mesh_seconds = e.prepared.mesh_seconds;
   p.model = prepare_model(p.scene, p.warnings, unload_, &f->solvers);
   p.prepare_seconds = since(t0);
-  seconds = p.prepare_seconds;
   e.element = std::move(f);
   return *e.element;
 }
@@ -145,7 +143,9 @@ RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const 
   for (const auto& rep : r.reports)
     if (!rep.converged) why.nodal_stop += (why.nodal_stop.empty() ? "" : "; ") + rep.name + ": " + rep.stop_reason;
   why.nodal_seconds = r.seconds;
-  Entry& f = element_entry(e, why.prepare_seconds);
+  const bool first = !e.element;
+  Entry& f = element_entry(e);
+  if (first) why.prepare_seconds = f.prepared.prepare_seconds;
   Scene s = supine;
   s.material.volume_form = VolumeForm::Element;
   RegistrationResult fr = run_registration(s, f.prepared.model, opt, callback, &f.solvers);
@@ -335,9 +335,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
 }
 
 RegistrationEngine::Entry& RegistrationEngine::nominal_entry(Entry& e, const RegistrationResult& nominal) {
-  if (!nominal.volume_form_fallback) return e;
-  double seconds = 0;
-  return element_entry(e, seconds);
+  return nominal.volume_form_fallback ? element_entry(e) : e;
 }
 
 int RegistrationEngine::solvers_built() const {

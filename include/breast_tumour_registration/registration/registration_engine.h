@@ -94,8 +94,8 @@ class RegistrationEngine {
     std::unique_ptr<Entry> element;
   };
   Entry& entry(const RegistrationOptions& opt);
-  /// e's element-form twin, prepared on first use (`seconds`: the time that took, else 0)
-  Entry& element_entry(Entry& e, double& seconds);
+  /// e's element-form twin, prepared on first use
+  Entry& element_entry(Entry& e);
   /// The entry `nominal` was computed on: e, or its element-form twin where it fell back
   Entry& nominal_entry(Entry& e, const RegistrationResult& nominal);
   RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);
