@@ -18,14 +18,21 @@
 
 namespace btr::fuzz {
 
-/// A per-process scratch folder (several fuzzing jobs may run at once).
+/// A per-process scratch folder (several fuzzing jobs may run at once), removed when the
+/// process exits normally (a crash leaves it, with the input that caused it).
 inline const std::string& scratch() {
-  static const std::string dir = [] {
-    const auto d = std::filesystem::temp_directory_path() / ("btr_fuzz_" + std::to_string(getpid()));
-    std::filesystem::create_directories(d);
-    return d.string();
-  }();
-  return dir;
+  struct Folder {
+    std::string path;
+    Folder() : path((std::filesystem::temp_directory_path() / ("btr_fuzz_" + std::to_string(getpid()))).string()) {
+      std::filesystem::create_directories(path);
+    }
+    ~Folder() {
+      std::error_code ignored;
+      std::filesystem::remove_all(path, ignored);
+    }
+  };
+  static const Folder dir;
+  return dir.path;
 }
 
 inline std::string write_input(const std::string& name, const uint8_t* data, size_t size) {
