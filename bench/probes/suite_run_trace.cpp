@@ -49,7 +49,9 @@ int main(int argc, char** argv) {
       if (std::getenv("PROBE_V")) std::printf("  %s it %d E %.6g |g| %.3g alpha %.3g inv %ld\n", step.c_str(), it.iteration, it.energy, it.gradient_norm, it.alpha, it.inverted);
       return true; };
     const RegistrationResult r = engine.solve(ro, cb);
-    for (auto& [e, m] : r.stiffness_evaluations) std::printf("  candidate E %.1f Pa: misfit %.4f mm\n", e, m * 1e3);
+    for (const auto& c : r.stiffness_evaluations)
+      std::printf("  candidate E %.1f Pa: misfit %.4f mm, %d forward solves, %.2f s%s%s\n", c.youngs_modulus, c.misfit * 1e3,
+                  c.forward_solves, c.seconds, c.failure.empty() ? "" : ": ", c.failure.c_str());
     for (const auto& rep : r.reports)
     {
       std::printf("%s: %s inv %ld %.2f s: %s\n", rep.name.c_str(), rep.converged ? "C" : "NC", rep.inverted, rep.seconds, rep.stop_reason.c_str());

@@ -25,6 +25,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   if (pb.volume_form == VolumeForm::Auto) throw InputError("unload: resolve the volume form first");
   if (!(opt.tolerance > 0) || opt.max_iterations < 1 || opt.anderson_depth < 0)
     throw InputError("unload: tolerance must be > 0, max_iterations >= 1 and anderson_depth >= 0");
+  if (opt.max_forward_solves < 0) throw InputError("unload: the forward-solve budget must be >= 0 (0: none)");
   if (!(pb.gravity.norm() > 0)) throw InputError("unload: the imaging gravity must not be zero");
   const TetMesh& loaded = *pb.loaded;
   const Eigen::Index nv = loaded.V.rows();
@@ -39,8 +40,12 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
                      pb.density, opt.forward, pb.solver);
   UnloadResult res;
   int first = 0;  // Newton iterations of the first converged forward solve: the cost unit
-  // phi(X) under gravity g; x the start, then the equilibrium. false: it failed (x unchanged).
+  const std::string budget_spent = "forward-solve budget (" + std::to_string(opt.max_forward_solves) + ") spent";
+  auto spent = [&] { return opt.max_forward_solves > 0 && res.iterations >= opt.max_forward_solves; };
+  // phi(X) under gravity g; x the start, then the equilibrium. false: it failed (x unchanged),
+  // or the budget was spent (not attempted).
   auto forward = [&](const Points& X, Points& x, const Vec3& g) {
+    if (spent()) return false;
     const int before = phi.newton_iterations();
     bool ok = true;
     try {
@@ -74,7 +79,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
       }
     }
     if (!st.started) {
-      st.reason = "the first forward solve did not converge from the first estimate";
+      st.reason = spent() ? budget_spent : "the first forward solve did not converge from the first estimate";
       return st;
     }
     st.X = X;
@@ -152,8 +157,9 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
         }
       }
       if (!moved) {
-        st.reason = "no forward solve converged from the next estimate, nor from a plain or halved step; mismatch " +
-                    format_mm(st.best, 3);
+        st.reason = spent() ? budget_spent + ", mismatch " + format_mm(st.best, 3)
+                            : "no forward solve converged from the next estimate, nor from a plain or halved step; mismatch " +
+                                  format_mm(st.best, 3);
         break;
       }
     }
@@ -181,12 +187,12 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   // Else load continuation of the inverse problem: the unloaded shape for a growing fraction of
   // the gravity, each stage started from the last two extrapolated (a soft breast whose prone
   // sag is too large for one step).
-  if (!result.converged && opt.max_stages > 0) {
+  if (!result.converged && opt.max_stages > 0 && !spent()) {
     ++res.continuation_stages;  // the direct attempt
     double s = 0, s_prev = 0, ds = opt.first_stage_fraction;
     Points X_s = xp, X_prev = xp;
     std::string failure;
-    while (s < 1 && res.continuation_stages <= opt.max_stages) {
+    while (s < 1 && res.continuation_stages <= opt.max_stages && !spent()) {
       const double next = std::min(1.0, s + ds);
       Points init = X_s;
       if (s > 0) {
@@ -212,7 +218,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
       }
     }
     if (!result.converged)
-      result.reason = "neither directly nor by load continuation (" + std::to_string(res.continuation_stages) +
+      result.reason = std::string(spent() ? budget_spent + ": " : "") + "neither directly nor by load continuation (" + std::to_string(res.continuation_stages) +
                       " stages, reached " + std::to_string(static_cast<int>(std::lround(s * 100))) + " % of the gravity" +
                       (failure.empty() ? "" : "; last failure " + failure) + "): " + result.reason;
   }

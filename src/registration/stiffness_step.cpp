@@ -83,8 +83,11 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   NewtonSolver* shared = cache ? &cache->gravity(model) : nullptr;
   if (!(opt.candidate_tolerance > 0) || !std::isfinite(opt.candidate_tolerance))
     throw InputError("stiffness: the candidates' unload tolerance must be positive");
+  if (!(opt.candidate_budget_factor >= 0) || opt.min_candidate_forward_solves < 1)
+    throw InputError("stiffness: the candidates' forward-solve budget needs a factor >= 0 and a minimum >= 1");
   UnloadOptions candidate_unload = opt.unload;
   candidate_unload.tolerance = std::max(opt.unload.tolerance, opt.candidate_tolerance);
+  int most_forward_solves = 0;  // by a candidate that was simulated: the budget's scale
 
   // Every converged candidate's (log E, unloaded shape): the next one starts from the two
   // nearest it in log E (interpolated between them when it lies between, else extrapolated),
@@ -118,7 +121,23 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   // slope at the estimate says how well the landmarks fix E (StiffnessEstimate::log_sd).
   std::vector<std::pair<double, Eigen::VectorXd>> residuals;
   auto evaluate = [&](double E) {
+    const auto tc = std::chrono::steady_clock::now();
     Candidate c;
+    StiffnessCandidate record;
+    record.youngs_modulus = E;
+    UnloadOptions uo = candidate_unload;
+    if (opt.candidate_budget_factor > 0)
+      uo.max_forward_solves = std::max(opt.min_candidate_forward_solves,
+                                       static_cast<int>(std::ceil(opt.candidate_budget_factor * most_forward_solves)));
+    // Every return: the record, its cost, and the budget's scale where it was simulated.
+    auto done = [&](std::string failure) {
+      record.misfit = c.misfit;
+      record.failure = std::move(failure);
+      record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
+      if (record.failure.empty()) most_forward_solves = std::max(most_forward_solves, record.forward_solves);
+      est.evaluations.push_back(record);
+      return std::move(c);
+    };
     const double k = E / E0;  // the material scaled by k == the gravities divided by k
     UnloadProblem pb = unload_problem(model, prone, prone_gravity / k);
     pb.solver = shared;
@@ -135,20 +154,20 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
       guess = n1->second;
       pb.initial_rest = &guess;
     }
-    c.unload = estimate_unloaded_shape(pb, candidate_unload);
-    if (!pb.initial_rest || !c.unload.converged) {  // the extrapolation misled it: from inverse gravity
-      if (pb.initial_rest && !c.unload.converged) {
-        pb.initial_rest = nullptr;
-        UnloadResult fresh = estimate_unloaded_shape(pb, candidate_unload);
-        if (fresh.max_mismatch < c.unload.max_mismatch) c.unload = std::move(fresh);
-      }
+    c.unload = estimate_unloaded_shape(pb, uo);
+    record.forward_solves = c.unload.iterations;
+    // The extrapolation misled it: from inverse gravity, on what is left of the budget.
+    if (pb.initial_rest && !c.unload.converged && (uo.max_forward_solves == 0 || record.forward_solves < uo.max_forward_solves)) {
+      pb.initial_rest = nullptr;
+      if (uo.max_forward_solves > 0) uo.max_forward_solves -= record.forward_solves;
+      UnloadResult fresh = estimate_unloaded_shape(pb, uo);
+      record.forward_solves += fresh.iterations;
+      if (fresh.max_mismatch < c.unload.max_mismatch) c.unload = std::move(fresh);
     }
     if (c.unload.converged) known.emplace_back(u, c.unload.rest);
     // A candidate whose unloaded shape does not reproduce the prone shape is not a candidate.
-    if (!(c.unload.max_mismatch < std::max({10 * opt.unload.tolerance, opt.unload.stage_tolerance, candidate_unload.tolerance}))) {
-      est.evaluations.emplace_back(E, c.misfit);
-      return c;
-    }
+    if (!(c.unload.max_mismatch < std::max({10 * opt.unload.tolerance, opt.unload.stage_tolerance, candidate_unload.tolerance})))
+      return done("unload: " + c.unload.stop_reason);
     c.rest = c.unload.rest;
     ForwardGravity phi(model.rest.T, model.prone.rows(), model.chest_wall, model.materials, model.material_of,
                        model.volume_form, model.material.nodal_element_share, model.material.density,
@@ -158,11 +177,11 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
       x = c.rest + std::exp(near->first - u) * near->second;
       if (count_inverted(x, model.rest.T) > 0) x = c.rest;
     }
+    ++record.forward_solves;
     try {
       phi.solve(c.rest, model.gravity / k, x);
-    } catch (const SolverError&) {
-      est.evaluations.emplace_back(E, c.misfit);
-      return c;
+    } catch (const SolverError& e) {
+      return done(std::string("supine solve: ") + e.what());
     }
     supine_displacements.emplace_back(u, x - c.rest);
     c.supine = x;
@@ -173,8 +192,7 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
     const Points r = fitted - predicted;
     c.misfit = std::sqrt(r.rowwise().squaredNorm().mean());
     residuals.emplace_back(u, Eigen::Map<const Eigen::VectorXd>(r.data(), r.size()));
-    est.evaluations.emplace_back(E, c.misfit);
-    return c;
+    return done("");
   };
 
   // The grid walk (stiffness_grid_walk.h): the candidates before the refinement, stiff to soft.

@@ -237,7 +237,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
     }
   }
   const std::vector<double>& moduli = opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli;
-  const RegistrationOptions preset = preset_options(opt.preset);
+  RegistrationOptions preset = preset_options(opt.preset);
+  preset.stiffness.candidate_budget_factor = opt.method_stiffness_budget;
   if (opt.given_configurations)
     for (double e : moduli)
       if (!opt.given_configurations->count(e))

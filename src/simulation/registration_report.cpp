@@ -147,8 +147,12 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                                                   {"element_prepare_seconds", num(f->prepare_seconds)}};
   if (r.steps.stiffness) {
     Json evaluations = Json::array();
-    for (const auto& [E, misfit] : r.stiffness_evaluations)
-      evaluations.push_back({{"youngs_modulus_Pa", num(E)}, {"landmark_misfit_mm", num(misfit * 1e3)}});
+    for (const auto& c : r.stiffness_evaluations) {
+      Json e = {{"youngs_modulus_Pa", num(c.youngs_modulus)}, {"landmark_misfit_mm", num(c.misfit * 1e3)},
+                {"forward_solves", c.forward_solves}, {"seconds", num(c.seconds)}};
+      if (!c.failure.empty()) e["not_simulated"] = c.failure;
+      evaluations.push_back(e);
+    }
     j["stiffness"] = {{"estimated_youngs_modulus_Pa", num(r.estimated_youngs_modulus)},
                       {"log_sd", num(r.estimated_youngs_modulus_log_sd)},  // sd of ln E the landmarks leave (0: not known)
                       {"evaluations", evaluations}};

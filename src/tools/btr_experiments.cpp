@@ -67,6 +67,12 @@ int main(int argc, char** argv) {
                  "(material.nodal_fallback)")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+  double stiffness_budget = ExperimentSuiteOptions().method_stiffness_budget;
+  app.add_option("--stiffness-budget", stiffness_budget,
+                 "with E estimated: a stiffness candidate's unload may take this many times the forward solves of the "
+                 "costliest candidate simulated so far (at least 30); 0: no budget")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--cell-size", cell_mm, "built-in phantom: tetrahedron size bound [mm] (8: ~6k tets, 4.7: ~35k)")
       ->capture_default_str();
   app.add_option("-p,--preset", preset, "registration preset: fast, balanced, accurate")->capture_default_str();
@@ -110,6 +116,7 @@ int main(int argc, char** argv) {
     opt.method_volume_form = parse_volume_form(volume_form);
     opt.method_nodal_element_share = nodal_element_share;
     opt.method_nodal_fallback = nodal_fallback == "on";
+    opt.method_stiffness_budget = stiffness_budget;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};
     preset_options(preset);  // validates the name before the expensive steps
     const std::vector<ExperimentRun> runs = plan_experiments(opt);

@@ -127,6 +127,10 @@ int main(int argc, char** argv) {
                     "%.3f s\n",
                     s.name.c_str(), s.stiffness_youngs_modulus, s.outer_iterations, s.stiffness_misfit * 1e3,
                     s.stop_reason.c_str(), s.seconds);
+        for (const auto& c : r.stiffness_evaluations)
+          if (!c.failure.empty())
+            std::printf("[%-8s]   %.0f Pa not simulated (%d forward solves, %.2f s): %s\n", s.name.c_str(), c.youngs_modulus,
+                        c.forward_solves, c.seconds, c.failure.c_str());
         continue;
       }
       const char* outer = s.name == "unload" ? " forward solves" : " projections";

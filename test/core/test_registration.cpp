@@ -319,17 +319,17 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
     const StiffnessOptions so;
     const auto& ev = r.stiffness_evaluations;
     size_t walk = 1;
-    while (walk < ev.size() && ev[walk].first < ev[walk - 1].first) ++walk;
+    while (walk < ev.size() && ev[walk].youngs_modulus < ev[walk - 1].youngs_modulus) ++walk;
     ASSERT_GE(walk, 3u);
-    double best = ev[0].second;
+    double best = ev[0].misfit;
     for (size_t i = 1; i + 1 < walk; ++i) {
-      EXPECT_LE(ev[i].second, 1.5 * best) << "the walk went on past a candidate 1.5x the best at " << ev[i].first << " Pa";
-      best = std::min(best, ev[i].second);
+      EXPECT_LE(ev[i].misfit, 1.5 * best) << "the walk went on past a candidate 1.5x the best at " << ev[i].youngs_modulus << " Pa";
+      best = std::min(best, ev[i].misfit);
     }
-    const double last = ev[walk - 1].first;
+    const double last = ev[walk - 1].youngs_modulus;
     const bool on_grid = on_stiffness_grid(std::log(last), stiffness_grid(so.min_youngs_modulus, so.max_youngs_modulus, so.grid_points));
-    EXPECT_GT(ev[walk - 1].second, (on_grid ? 1.5 : 1.0) * best) << "the walk stopped at " << last << " Pa";
-    for (size_t i = walk; i < ev.size(); ++i) EXPECT_GT(ev[i].first, last) << "a refinement candidate outside the bracket";
+    EXPECT_GT(ev[walk - 1].misfit, (on_grid ? 1.5 : 1.0) * best) << "the walk stopped at " << last << " Pa";
+    for (size_t i = walk; i < ev.size(); ++i) EXPECT_GT(ev[i].youngs_modulus, last) << "a refinement candidate outside the bracket";
   }
   // Issue 14: the estimate's own spread (1.5 mm landmarks) replaces the range's in the region:
   // far narrower than the range's sd of ln E (0.78 for 200 to 3000 Pa), and it holds the truth.
@@ -370,6 +370,58 @@ TEST(Stiffness, EstimatedFromTheLandmarksItFindsTheSoftBreast) {
 
 // Issue 14: how well the landmarks fix E. Gauss-Newton: sd(ln E) = sigma / |dr/d ln E|, sigma
 // the landmarks' sd, or the misfit per residual degree of freedom (3n - 7) where larger.
+// A candidate's unload gets a budget of forward solves: max(minimum, factor x the most a
+// simulated candidate took so far). Past it the candidate is one that cannot be simulated, and
+// says why; before the first candidate it stops, the search is the unbudgeted one. Here a
+// factor of 1 makes it bind on the 600 Pa phantom, whose softer candidates need more solves.
+TEST(Stiffness, ACandidateOverItsForwardSolveBudgetIsNotSimulatedAndSaysWhy) {
+  const Scene s = load_meshed_scene(
+      scene_with("material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]", "estimate_budget", soft_phantom_dir("phantom12_soft_budget")));
+  std::vector<std::string> w;
+  const RegistrationModel m = prepare_model(s, w);
+  StiffnessOptions so;
+  const StiffnessEstimate free = estimate_stiffness(m, *s.prone_gravity, s.landmark_anchors, s.landmark_supine, so);
+  so.candidate_budget_factor = 1;
+  so.min_candidate_forward_solves = 3;
+  StiffnessEstimate tight;
+  try {
+    tight = estimate_stiffness(m, *s.prone_gravity, s.landmark_anchors, s.landmark_supine, so);
+  } catch (const SolverError& e) {  // every candidate over the budget: a search with nothing to compare
+    FAIL() << e.what();
+  }
+  auto print = [](const char* name, const StiffnessEstimate& e) {
+    std::printf("%s: E %.0f Pa (%s)\n", name, e.youngs_modulus, e.stop_reason.c_str());
+    for (const auto& c : e.evaluations)
+      std::printf("  %7.1f Pa: misfit %.3f mm, %d forward solves %s\n", c.youngs_modulus, c.misfit * 1e3, c.forward_solves, c.failure.c_str());
+  };
+  print("no factor", free);
+  print("factor 1", tight);
+  int most = 0, stopped = 0;
+  bool diverged = false;
+  for (size_t i = 0; i < tight.evaluations.size(); ++i) {
+    const StiffnessCandidate& c = tight.evaluations[i];
+    const int budget = std::max(so.min_candidate_forward_solves, most);
+    EXPECT_EQ(std::isfinite(c.misfit), c.failure.empty()) << c.youngs_modulus << " Pa";
+    if (c.failure.find("forward-solve budget (" + std::to_string(budget) + ") spent") != std::string::npos) {
+      EXPECT_EQ(c.forward_solves, budget);  // its unload spent it; no supine solve
+      ++stopped;
+      diverged = true;
+    } else {
+      EXPECT_LE(c.forward_solves, budget + 1) << c.youngs_modulus << " Pa";  // the unload's and the supine solve
+      if (!diverged) {
+        ASSERT_LT(i, free.evaluations.size());
+        EXPECT_EQ(c.youngs_modulus, free.evaluations[i].youngs_modulus);
+        EXPECT_EQ(c.misfit, free.evaluations[i].misfit);
+        EXPECT_EQ(c.forward_solves, free.evaluations[i].forward_solves);
+      }
+    }
+    if (c.failure.empty()) most = std::max(most, c.forward_solves);
+  }
+  EXPECT_GE(stopped, 1) << "the test needs a candidate over its budget";
+  so.candidate_budget_factor = -1;
+  EXPECT_THROW(estimate_stiffness(m, *s.prone_gravity, s.landmark_anchors, s.landmark_supine, so), InputError);
+}
+
 TEST(Stiffness, TheEstimatesSpreadIsTheLandmarkNoiseOverTheMisfitsSlope) {
   StiffnessEstimate e;
   e.landmarks = 5;                 // 8 residual degrees of freedom

@@ -68,6 +68,54 @@ TEST(Unload, BadInputIsRefused) {
   EXPECT_THROW(estimate_unloaded_shape(pb), InputError);  // unresolved form
 }
 
+// A budget on the forward solves (what the stiffness search gives a candidate) stops the
+// estimate once spent, as not converged, naming the budget and keeping the best estimate; a
+// budget the estimate does not reach changes nothing. Then the same within load continuation:
+// the direct fixed point capped at 4 forward solves, too few at 200 Pa.
+TEST(Unload, AForwardSolveBudgetStopsItAndSaysSo) {
+  const PhantomModel model = coarse_phantom();
+  PhantomSceneOptions so;
+  so.youngs_modulus = 200;
+  const PhantomConfigurations conf = simulate_phantom(model, so);
+  const TetMesh prone{conf.prone, model.rest.T};
+  UnloadProblem pb;
+  pb.loaded = &prone;
+  pb.fixed = model.chest_wall;
+  pb.materials = {StableNeoHookean(so.youngs_modulus, so.poisson_ratio)};
+  pb.volume_form = resolve_volume_form(VolumeForm::Auto, so.poisson_ratio);
+  pb.gravity = model.prone_gravity;
+  UnloadOptions opt;
+  opt.forward.newton.gradient_rel_tolerance = 1e-9;
+  auto expect_cut = [&](const UnloadResult& r, int budget) {
+    EXPECT_FALSE(r.converged);
+    EXPECT_EQ(r.iterations, budget);
+    EXPECT_NE(r.stop_reason.find("forward-solve budget (" + std::to_string(budget) + ") spent"), std::string::npos) << r.stop_reason;
+    EXPECT_EQ(count_inverted(r.rest, prone.T), 0);
+  };
+  const UnloadResult free = estimate_unloaded_shape(pb, opt);
+  ASSERT_TRUE(free.converged) << free.stop_reason;
+  ASSERT_GE(free.iterations, 4);
+  opt.max_forward_solves = free.iterations;
+  const UnloadResult enough = estimate_unloaded_shape(pb, opt);
+  EXPECT_TRUE(enough.converged);
+  EXPECT_EQ(enough.iterations, free.iterations);
+  EXPECT_EQ(enough.rest, free.rest);
+  opt.max_forward_solves = free.iterations / 2;
+  const UnloadResult cut = estimate_unloaded_shape(pb, opt);
+  std::printf("200 Pa: %d forward solves unbudgeted; a budget of %d: %s\n", free.iterations, opt.max_forward_solves,
+              cut.stop_reason.c_str());
+  expect_cut(cut, opt.max_forward_solves);
+
+  opt.max_iterations = 4;  // the direct attempt spends 5 (with the inverse-gravity solve), continuation the rest
+  opt.max_forward_solves = 10;
+  const UnloadResult continued = estimate_unloaded_shape(pb, opt);
+  std::printf("direct capped at 4, a budget of 10: %s\n", continued.stop_reason.c_str());
+  EXPECT_GT(continued.continuation_stages, 1) << "the test needs load continuation";
+  expect_cut(continued, opt.max_forward_solves);
+  opt.max_forward_solves = -1;
+  EXPECT_THROW(estimate_unloaded_shape(pb, opt), InputError);
+}
+
 // Softer than anything that could have made the shape: the 200 Pa prone shape unloaded with a
 // 100 Pa material. It converges or stops with a reason; it never reports converged with a
 // mismatch above the tolerance, and it keeps an estimate no worse than its first.

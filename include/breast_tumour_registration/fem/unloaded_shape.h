@@ -31,6 +31,11 @@ struct UnloadOptions {
   double stage_tolerance = 1e-4;  ///< [m]
   int max_stages = 12;
   int anderson_depth = 5;    ///< 0: plain fixed point
+  /// A budget on the forward solves of the whole estimate, over the direct attempt and every
+  /// continuation stage (0: none). Spent, the estimate stops as not converged, saying so, with
+  /// the best estimate found; a caller that only compares candidates (the stiffness search)
+  /// stops a hopeless one with it instead of letting continuation run on.
+  int max_forward_solves = 0;
   /// Each forward solve (its Newton gradient tolerance should be far below `tolerance`) and
   /// its load continuation when one load step does not converge.
   ForwardGravityOptions forward;

@@ -136,7 +136,7 @@ struct RegistrationResult {
   /// [Pa] the stiffness step's estimate (0: not estimated); the steps simulated with every
   /// material scaled to it
   double estimated_youngs_modulus = 0;
-  std::vector<std::pair<double, double>> stiffness_evaluations;  ///< (E [Pa], landmark misfit [m]) it tried
+  std::vector<StiffnessCandidate> stiffness_evaluations;  ///< the candidates it tried, in order
   /// The sd of ln E about the estimate, from the landmarks' sd (the uncertainty sources') and
   /// how the misfit moves with E (StiffnessEstimate::log_sd); 0: not known or not estimated
   double estimated_youngs_modulus_log_sd = 0;

@@ -15,6 +15,7 @@
 // so a candidate is simulated with the gravities divided by the factor.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,7 +43,23 @@ struct StiffnessOptions {
   /// (or unload.tolerance, if larger); only the chosen candidate is then finished to
   /// unload.tolerance. The misfit moves by about this much, far less than between candidates.
   double candidate_tolerance = 1e-4;
+  /// A candidate's unload may take at most max(min_candidate_forward_solves,
+  /// candidate_budget_factor x the most forward solves a simulated candidate took so far);
+  /// past it the candidate counts as one that cannot be simulated (as above). Candidates that
+  /// converge take 2 to 12 here; one that continuation cannot carry took 193 (a minute) before
+  /// failing anyway. 0: no budget.
+  double candidate_budget_factor = 4;
+  int min_candidate_forward_solves = 30;
   UnloadOptions unload;               ///< of every candidate's unload, and of the chosen one's finish
+};
+
+/// One candidate of the search.
+struct StiffnessCandidate {
+  double youngs_modulus = 0;  ///< [Pa] of the model's first material
+  double misfit = std::numeric_limits<double>::infinity();  ///< [m] RMS landmark misfit (inf: not simulated)
+  int forward_solves = 0;     ///< its unload's forward solves, and its supine solve
+  double seconds = 0;
+  std::string failure;        ///< why it could not be simulated (empty: it was)
 };
 
 struct StiffnessEstimate {
@@ -52,7 +69,7 @@ struct StiffnessEstimate {
   bool converged = false;     ///< the refinement met relative_tolerance inside the range
   bool at_bound = false;      ///< the best candidate is an end of the range (the estimate is a bound)
   std::string stop_reason;
-  std::vector<std::pair<double, double>> evaluations;  ///< (E [Pa], misfit [m]), in the order evaluated (inf: failed)
+  std::vector<StiffnessCandidate> evaluations;  ///< in the order evaluated
   int landmarks = 0;
   /// [m] |dr / d ln E| at the estimate, r the Kabsch-fitted landmark residual (3n): from the
   /// simulated candidates nearest the estimate on each side (0: none was).

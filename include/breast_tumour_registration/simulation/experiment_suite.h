@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "breast_tumour_registration/io/scene.h"
+#include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/simulation/phantom.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 
@@ -58,6 +59,9 @@ struct ExperimentSuiteOptions {
   /// The method's Scene::nodal_fallback: a nodal run that ends not converged is run again with
   /// the element form (its status then ends in " (element form: the nodal did not converge)")
   bool method_nodal_fallback = true;
+  /// The stiffness search's StiffnessOptions::candidate_budget_factor (0: no budget on a
+  /// candidate's forward solves, as before 2026-12-06).
+  double method_stiffness_budget = StiffnessOptions{}.candidate_budget_factor;
   /// > 0 [m]: every run's prone model is re-tetrahedralized from its boundary at this size
   /// (with_simulation_mesh), as btr_register meshes a prone surface; 0: the model's own mesh
   /// (with given configurations, the mesh their truth was computed on).
