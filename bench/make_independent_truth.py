@@ -27,7 +27,8 @@ and truth.json (moduli, sags, load steps, seconds).
 
 For the experiment suite (btr_experiments --model OUT/model.yaml --truth OUT/truth.yaml) it also
 writes the rest model once (OUT/model.yaml: the TetGen mesh with its tissue labels, chest wall,
-landmark vertices, rest tumours, both gravities) and, per fat modulus, the prone and supine
+landmark vertices, rest tumours, both gravities; OUT/model_regions.yaml also gives the method
+the tissue layout, the labels at the truth's ratios) and, per fat modulus, the prone and supine
 volumes (prone_volume.vtk, supine_volume.vtk: the rest mesh's vertices moved by the P2 solution,
 the same tetrahedra); OUT/truth.yaml lists every configuration written so far.
 
@@ -146,8 +147,10 @@ def linear_solver_of(name):
     return ScipyDirect({})
 
 
-def write_rest_model(out, node, ele, lab, chest_vertices, landmarks, tum_surf):
-    """OUT/model.yaml for btr_experiments --model: the rest shape the configurations came from."""
+def write_rest_model(out, node, ele, lab, chest_vertices, landmarks, tum_surf, gland_ratio, tumour_ratio):
+    """OUT/model.yaml for btr_experiments --model: the rest shape the configurations came from;
+    OUT/model_regions.yaml the same with the tissue layout (cell labels 2 gland, 3 tumour) given to
+    the method's model at the truth's stiffness ratios."""
     write_vtk(os.path.join(out, 'rest.vtk'), node, ele, lab)
     np.savetxt(os.path.join(out, 'chest_wall_rest.txt'), chest_vertices, fmt='%d')
     with open(os.path.join(out, 'landmark_vertices.txt'), 'w') as f:
@@ -159,6 +162,11 @@ def write_rest_model(out, node, ele, lab, chest_vertices, landmarks, tum_surf):
         f.write('units: mm\nrest: rest.vtk\nchest_wall: chest_wall_rest.txt\nlandmarks: landmark_vertices.txt\n')
         f.write('tumours:\n' + ''.join('  %s: tumour_%s_rest.obj\n' % (n, n) for n in sorted(tum_surf)))
         f.write('gravity:\n  prone: [0, 0, %g]\n  supine: [0, 0, %g]\n' % (G, -G))
+    with open(os.path.join(out, 'model.yaml')) as f:
+        plain = f.read()
+    with open(os.path.join(out, 'model_regions.yaml'), 'w') as f:
+        f.write(plain + 'regions:\n  - {name: gland, label: 2, relative_stiffness: %g}\n'
+                '  - {name: tumour, label: 3, relative_stiffness: %g}\n' % (gland_ratio, tumour_ratio))
 
 
 def write_truth_list(out, names):
@@ -314,7 +322,8 @@ def main():
     gland_surf = (np.asarray(gland_surf[0]) * gland['axes'] + gland['centre'], gland_surf[1])
     gland_surf[0][:, 2] = np.maximum(gland_surf[0][:, 2], 0.5)  # the ellipsoid's part behind the chest wall is cut off
     node_m = node * 1e-3
-    write_rest_model(o.out, node, ele, lab, np.nonzero(np.abs(node[:, 2]) < 1e-9)[0], landmarks, tum_surf)
+    write_rest_model(o.out, node, ele, lab, np.nonzero(np.abs(node[:, 2]) < 1e-9)[0], landmarks, tum_surf,
+                     o.gland_ratio, o.tumour_ratio)
     print('%d vertices, %d tetrahedra (fat %d, gland %d, tumour %d), %d skin vertices' %
           (len(node), len(ele), (lab == 1).sum(), (lab == 2).sum(), (lab == 3).sum(), len(used)))
     for fat in o.fat_youngs_moduli:

@@ -195,6 +195,16 @@ Scene experiment_scene(const PhantomModel& model, const PhantomConfigurations& c
     s.tumours.push_back(t);
   }
   s.material.youngs_modulus = run.method_youngs_modulus;
+  if (!model.method_regions.empty()) {  // the tissue layout the model file gives, relative to the method's E
+    s.prone_labels = model.rest_labels;
+    for (const auto& r : model.method_regions) {
+      MaterialRegion mr;
+      mr.name = r.name;
+      mr.label = r.label;
+      mr.youngs_modulus = r.relative_stiffness * run.method_youngs_modulus;
+      s.regions.push_back(std::move(mr));
+    }
+  }
   if (shape == "estimated") s.youngs_modulus_range = std::array<double, 2>{150, 24000};
   const Rigid g = misalignment_from_degrees_mm(run.gravity_rotation_deg, Vec3::Zero());
   s.gravity = g.linear() * model.supine_gravity;

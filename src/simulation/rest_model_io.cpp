@@ -1,5 +1,7 @@
 #include "breast_tumour_registration/simulation/rest_model_io.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -19,7 +21,8 @@ namespace fs = std::filesystem;
 namespace {
 const std::vector<std::string> kModelKeys = {"units",      "rest",       "surface",      "cell_size_mm", "chest_wall",
                                              "landmarks",  "chest_ring", "tumours.*",    "gravity",      "gravity.prone",
-                                             "gravity.supine"};
+                                             "gravity.supine", "regions", "regions[].name", "regions[].label",
+                                             "regions[].relative_stiffness", "cell_labels"};
 
 PhantomModel load_rest_model_fields(const std::string& path) {
   const YamlFields c{path, fs::path(path).parent_path()};
@@ -33,6 +36,8 @@ PhantomModel load_rest_model_fields(const std::string& path) {
   if (root["rest"] && root["surface"]) c.fail("surface", "give rest (a tetrahedral mesh) or surface (to tetrahedralize), not both");
   if (!root["rest"] && !root["surface"]) c.fail("rest", "missing: give rest (a tetrahedral mesh) or surface (a closed surface)");
   if (root["cell_size_mm"] && !root["surface"]) c.fail("cell_size_mm", "only with surface (the size it is tetrahedralized at)");
+  if (root["regions"] && !root["rest"]) c.fail("regions", "only with rest (a tetrahedral mesh whose cell labels they select)");
+  if (root["cell_labels"] && !root["regions"]) c.fail("cell_labels", "only with regions (it names the cell array they select by)");
 
   PhantomModel m;
   m.prone_gravity = c.vec3(root["gravity"]["prone"], "gravity.prone");
@@ -46,7 +51,13 @@ PhantomModel load_rest_model_fields(const std::string& path) {
   SurfaceMesh input_surface;
   if (root["rest"]) {
     m.rest = c.load("rest", [&] {
-      TetMesh t = read_tet_mesh(c.path_of(root["rest"], "rest"), unit);
+      const std::string rest_path = c.path_of(root["rest"], "rest");
+      TetMeshFile file = read_tet_mesh_file(rest_path, unit);
+      if (root["regions"]) {
+        const std::string array = root["cell_labels"] ? c.text(root["cell_labels"], "cell_labels") : "";
+        m.rest_labels = cell_labels(file, array, rest_path);
+      }
+      TetMesh t = std::move(file.mesh);
       orient_tets_positive(t);
       validate_tet_mesh(t, "rest");
       return t;
@@ -75,6 +86,26 @@ PhantomModel load_rest_model_fields(const std::string& path) {
   });
   if (root["chest_ring"])
     m.chest_ring = c.load("chest_ring", [&] { return read_surface(c.path_of(root["chest_ring"], "chest_ring"), unit); });
+  if (const YAML::Node rs = root["regions"]) {
+    if (!rs.IsSequence()) c.fail("regions", "expected a list of {name, label, relative_stiffness}");
+    int i = 0;
+    for (const auto& r : rs) {
+      const std::string f = "regions[" + std::to_string(i++) + "]";
+      if (!r.IsMap() || !r["name"] || !r["label"] || !r["relative_stiffness"])
+        c.fail(f, "expected {name, label, relative_stiffness}: a cell label of rest and its stiffness relative to the method's E");
+      PhantomModel::MethodRegion mr;
+      mr.name = c.text(r["name"], f + ".name");
+      const double l = c.number(r["label"], f + ".label");
+      if (l != std::round(l) || std::abs(l) > 1e9) c.fail(f + ".label", "expected an integer cell label");
+      mr.label = static_cast<int>(l);
+      if (std::find(m.rest_labels.begin(), m.rest_labels.end(), mr.label) == m.rest_labels.end())
+        c.fail(f + ".label", "no tetrahedron of rest carries the label " + std::to_string(mr.label));
+      mr.relative_stiffness = c.number(r["relative_stiffness"], f + ".relative_stiffness");
+      if (!(mr.relative_stiffness > 0) || !std::isfinite(mr.relative_stiffness))
+        c.fail(f + ".relative_stiffness", "must be a positive number");
+      m.method_regions.push_back(mr);
+    }
+  }
   const YAML::Node tumours = root["tumours"];
   if (!tumours.IsMap() || tumours.size() == 0) c.fail("tumours", "expected a mapping of name: surface file");
   for (const auto& kv : tumours) {
@@ -138,7 +169,7 @@ PhantomModel load_rest_model(const std::string& path) {
 void write_rest_model(const std::string& dir, const PhantomModel& model, LengthUnit unit) {
   fs::create_directories(dir);
   auto path = [&](const std::string& f) { return (fs::path(dir) / f).string(); };
-  write_tet_mesh(path("rest.vtk"), model.rest, unit);
+  write_tet_mesh(path("rest.vtk"), model.rest, unit, model.method_regions.empty() ? std::vector<int>{} : model.rest_labels);
   write_surface(path("rest_surface.obj"), model.surface, unit);
   write_index_list(path("chest_wall.txt"), model.chest_wall);
   std::vector<std::pair<std::string, int>> named(model.landmarks.begin(), model.landmarks.end());
@@ -157,6 +188,13 @@ void write_rest_model(const std::string& dir, const PhantomModel& model, LengthU
   for (const auto& [name, t] : model.tumours) {
     write_surface(path("tumour_" + name + "_rest.obj"), t, unit);
     y["tumours"][name] = "tumour_" + name + "_rest.obj";
+  }
+  for (const auto& r : model.method_regions) {
+    YAML::Node n;
+    n["name"] = r.name;
+    n["label"] = r.label;
+    n["relative_stiffness"] = r.relative_stiffness;
+    y["regions"].push_back(n);
   }
   YAML::Emitter e;
   e << y;

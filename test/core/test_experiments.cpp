@@ -146,6 +146,48 @@ TEST(ExperimentSuite, RunsOnARestModelReadFromFiles) {
   EXPECT_TRUE(std::any_of(said.begin(), said.end(), [](const std::string& l) { return l.find("skipped landmark_set") == 0; }));
 }
 
+// Issue 13: a rest model may give the method's model its tissue layout (a segmented MRI's): the
+// regions by cell label of `rest`, relative to the method's E. They survive the file round trip
+// and reach every run's scene scaled by that run's E, and the prepared model's materials follow.
+TEST(ExperimentSuite, AModelsTissueRegionsReachEveryRunsScene) {
+  const std::string dir = test::temp_dir();
+  PhantomModel layered = coarse_phantom();
+  ASSERT_GT(layered.gland.F.rows(), 0);
+  layered.rest_labels.assign(static_cast<size_t>(layered.rest.T.rows()), 1);
+  for (int t : tetrahedra_inside(layered.rest, {&layered.gland})) layered.rest_labels[static_cast<size_t>(t)] = 2;
+  layered.method_regions = {{"gland", 2, 3.0}};
+  write_rest_model(dir, layered, LengthUnit::Millimetre);
+  const PhantomModel m = load_rest_model(dir + "/model.yaml");
+  ASSERT_EQ(m.method_regions.size(), 1u);
+  EXPECT_EQ(m.method_regions[0].name, "gland");
+  EXPECT_EQ(m.method_regions[0].label, 2);
+  EXPECT_EQ(m.method_regions[0].relative_stiffness, 3.0);
+  EXPECT_EQ(m.rest_labels, layered.rest_labels);
+
+  PhantomSceneOptions gen;
+  gen.youngs_modulus = 2000;
+  const PhantomConfigurations conf = simulate_phantom(m, gen);
+  ExperimentSuiteOptions o;
+  o.experiments = {"material"};
+  o.quick = true;
+  const std::vector<ExperimentRun> runs = plan_experiments(o);
+  ASSERT_GE(runs.size(), 2u);
+  for (const ExperimentRun& run : runs) {
+    const Scene s = experiment_scene(m, conf, run, "balanced", "prone");
+    ASSERT_EQ(s.regions.size(), 1u);
+    EXPECT_EQ(s.regions[0].label, 2);
+    EXPECT_DOUBLE_EQ(s.regions[0].youngs_modulus, 3.0 * run.method_youngs_modulus);
+    EXPECT_EQ(s.prone_labels, layered.rest_labels);
+    std::vector<std::string> w;
+    const RegistrationModel rm = prepare_model(s, w);
+    for (size_t t = 0; t < rm.material_of.size(); ++t)
+      EXPECT_NEAR(rm.materials[static_cast<size_t>(rm.material_of[t])].youngs_modulus(),
+                  (layered.rest_labels[t] == 2 ? 3.0 : 1.0) * run.method_youngs_modulus, 1e-6 * run.method_youngs_modulus);
+  }
+  // Without regions the scene is homogeneous, as before.
+  EXPECT_TRUE(experiment_scene(coarse_phantom(), conf, runs[0], "balanced", "prone").regions.empty());
+}
+
 // A model whose chest wall is the plane x = 0 says so with its gravity: the suite must then
 // give what it gives for the same body lying along z (issue 10: before, it was simulated
 // sideways, 41.5 mm off).
@@ -332,6 +374,24 @@ TEST(RestModelErrors, NameTheFieldAtFault) {
   test::expect_throw_with<InputError>(
       [&] { load_rest_model(with("rest: rest.vtk\nchest_wall: chest_wall.txt\nlandmarks: landmark_vertices.txt\ntumours: {t: missing.obj}\n")); },
       "field 'tumours.t'");
+  // Tissue regions: by a cell label that rest carries, with its stiffness relative to the method's E.
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "regions: [{name: gland, label: 1, relative_stiffness: 2}]\n")); },
+                                      "field 'rest'");  // this rest.vtk has no cell labels
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "cell_labels: tissue\n")); }, "only with regions");
+  test::expect_throw_with<InputError>(
+      [&] { load_rest_model(with("surface: rest_surface.obj\nchest_wall: chest_wall.txt\nlandmarks: landmark_vertices.txt\n"
+                                 "tumours: {t: tumour_top_rest.obj}\nregions: [{name: g, label: 1, relative_stiffness: 2}]\n")); },
+      "only with rest");
+  PhantomModel labelled = coarse_phantom();
+  labelled.rest_labels.assign(static_cast<size_t>(labelled.rest.T.rows()), 1);
+  labelled.method_regions = {{"all", 1, 1.0}};
+  write_rest_model(dir, labelled, LengthUnit::Millimetre);
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "regions: [{name: gland, label: 7, relative_stiffness: 2}]\n")); },
+                                      "no tetrahedron of rest carries the label 7");
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "regions: [{name: gland, label: 1}]\n")); },
+                                      "expected {name, label, relative_stiffness}");
+  test::expect_throw_with<InputError>([&] { load_rest_model(with(body + "regions: [{name: gland, label: 1, relative_stiffness: -2}]\n")); },
+                                      "field 'regions[0].relative_stiffness': must be a positive number");
   test::write_text(dir + "/dup.txt", "a 1\na 2\n");
   test::expect_throw_with<InputError>([&] { read_named_indices(dir + "/dup.txt"); }, "given twice");
 }

@@ -38,6 +38,16 @@ struct PhantomModel {
   std::map<std::string, SurfaceMesh> tumours; ///< rest tumour spheres: top, middle, bottom, left, right
   SurfaceMesh gland;                          ///< rest fibroglandular region (closed; empty for a model read without one)
   std::map<std::string, int> landmarks;       ///< C, O1-O4, Oa-Od, I1-I4 -> tet boundary vertex
+  /// The tissue layout the method's model is given (a rest model file's `regions`: a segmented
+  /// MRI's): each run's scene gives these labels' tetrahedra `relative_stiffness` times the
+  /// method's E (scaled with it where E is estimated). Empty: the method's model is homogeneous.
+  struct MethodRegion {
+    std::string name;
+    int label = 0;                   ///< cell label of `rest`
+    double relative_stiffness = 1;   ///< times the method's Young's modulus
+  };
+  std::vector<MethodRegion> method_regions;
+  std::vector<int> rest_labels;               ///< cell label per rest tetrahedron (with method_regions)
   Vec3 prone_gravity = Vec3(0, 0, 9.81);      ///< [m/s^2] model frame: the phantom lies prone towards +z
   Vec3 supine_gravity = Vec3(0, 0, -9.81);    ///< [m/s^2] model frame
   std::vector<std::string> warnings;          ///< what loading repaired
