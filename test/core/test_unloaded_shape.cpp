@@ -24,24 +24,39 @@ PhantomModel coarse_phantom() {
   po.surface_rings = 12;
   return make_phantom_model(po);
 }
+// The coarse phantom's prone shape made at `made` Pa, and the problem of unloading it with a
+// material of another modulus.
+struct ProneShape {
+  PhantomModel model = coarse_phantom();
+  PhantomSceneOptions so;
+  PhantomConfigurations conf;
+  TetMesh prone;
+  explicit ProneShape(double made) {
+    so.youngs_modulus = made;
+    conf = simulate_phantom(model, so);
+    prone = TetMesh{conf.prone, model.rest.T};
+  }
+  UnloadProblem problem(double youngs_modulus) const {
+    UnloadProblem pb;
+    pb.loaded = &prone;
+    pb.fixed = model.chest_wall;
+    pb.materials = {StableNeoHookean(youngs_modulus, so.poisson_ratio)};
+    pb.volume_form = resolve_volume_form(VolumeForm::Auto, so.poisson_ratio);
+    pb.density = so.density;
+    pb.gravity = model.prone_gravity;
+    return pb;
+  }
+};
 }  // namespace
 
 class Unload : public ::testing::TestWithParam<double> {};
 
 TEST_P(Unload, RecoversThePhantomsRestShapeFromItsProneShape) {
   const double E = GetParam();
-  const PhantomModel model = coarse_phantom();
-  PhantomSceneOptions so;
-  so.youngs_modulus = E;
-  const PhantomConfigurations conf = simulate_phantom(model, so);
-  const TetMesh prone{conf.prone, model.rest.T};
-  UnloadProblem pb;
-  pb.loaded = &prone;
-  pb.fixed = model.chest_wall;
-  pb.materials = {StableNeoHookean(E, so.poisson_ratio)};
-  pb.volume_form = resolve_volume_form(VolumeForm::Auto, so.poisson_ratio);
-  pb.density = so.density;
-  pb.gravity = model.prone_gravity;
+  const ProneShape shape(E);
+  const PhantomModel& model = shape.model;
+  const PhantomConfigurations& conf = shape.conf;
+  const UnloadProblem pb = shape.problem(E);
   UnloadOptions opt;
   opt.forward.newton.gradient_rel_tolerance = 1e-9;
   const UnloadResult r = estimate_unloaded_shape(pb, opt);
@@ -71,19 +86,11 @@ TEST(Unload, BadInputIsRefused) {
 // A budget on the forward solves (what the stiffness search gives a candidate) stops the
 // estimate once spent, as not converged, naming the budget and keeping the best estimate; a
 // budget the estimate does not reach changes nothing. Then the same within load continuation:
-// the direct fixed point capped at 4 forward solves, too few at 200 Pa.
+// the direct fixed point capped at 2 forward solves, too few at 400 Pa.
 TEST(Unload, AForwardSolveBudgetStopsItAndSaysSo) {
-  const PhantomModel model = coarse_phantom();
-  PhantomSceneOptions so;
-  so.youngs_modulus = 200;
-  const PhantomConfigurations conf = simulate_phantom(model, so);
-  const TetMesh prone{conf.prone, model.rest.T};
-  UnloadProblem pb;
-  pb.loaded = &prone;
-  pb.fixed = model.chest_wall;
-  pb.materials = {StableNeoHookean(so.youngs_modulus, so.poisson_ratio)};
-  pb.volume_form = resolve_volume_form(VolumeForm::Auto, so.poisson_ratio);
-  pb.gravity = model.prone_gravity;
+  const ProneShape shape(400);
+  const TetMesh& prone = shape.prone;
+  const UnloadProblem pb = shape.problem(400);
   UnloadOptions opt;
   opt.forward.newton.gradient_rel_tolerance = 1e-9;
   auto expect_cut = [&](const UnloadResult& r, int budget) {
@@ -102,14 +109,14 @@ TEST(Unload, AForwardSolveBudgetStopsItAndSaysSo) {
   EXPECT_EQ(enough.rest, free.rest);
   opt.max_forward_solves = free.iterations / 2;
   const UnloadResult cut = estimate_unloaded_shape(pb, opt);
-  std::printf("200 Pa: %d forward solves unbudgeted; a budget of %d: %s\n", free.iterations, opt.max_forward_solves,
+  std::printf("400 Pa: %d forward solves unbudgeted; a budget of %d: %s\n", free.iterations, opt.max_forward_solves,
               cut.stop_reason.c_str());
   expect_cut(cut, opt.max_forward_solves);
 
-  opt.max_iterations = 4;  // the direct attempt spends 5 (with the inverse-gravity solve), continuation the rest
-  opt.max_forward_solves = 10;
+  opt.max_iterations = 2;  // the direct attempt spends 3 (with the inverse-gravity solve), continuation the rest
+  opt.max_forward_solves = 7;
   const UnloadResult continued = estimate_unloaded_shape(pb, opt);
-  std::printf("direct capped at 4, a budget of 10: %s\n", continued.stop_reason.c_str());
+  std::printf("direct capped at 2, a budget of 7: %s\n", continued.stop_reason.c_str());
   EXPECT_GT(continued.continuation_stages, 1) << "the test needs load continuation";
   expect_cut(continued, opt.max_forward_solves);
   opt.max_forward_solves = -1;
@@ -120,17 +127,9 @@ TEST(Unload, AForwardSolveBudgetStopsItAndSaysSo) {
 // 100 Pa material. It converges or stops with a reason; it never reports converged with a
 // mismatch above the tolerance, and it keeps an estimate no worse than its first.
 TEST(Unload, AtOneHundredPascalItConvergesOrSaysWhyNot) {
-  const PhantomModel model = coarse_phantom();
-  PhantomSceneOptions so;
-  so.youngs_modulus = 200;
-  const PhantomConfigurations conf = simulate_phantom(model, so);
-  const TetMesh prone{conf.prone, model.rest.T};
-  UnloadProblem pb;
-  pb.loaded = &prone;
-  pb.fixed = model.chest_wall;
-  pb.materials = {StableNeoHookean(100, so.poisson_ratio)};
-  pb.volume_form = resolve_volume_form(VolumeForm::Auto, so.poisson_ratio);
-  pb.gravity = model.prone_gravity;
+  const ProneShape shape(200);
+  const TetMesh& prone = shape.prone;
+  const UnloadProblem pb = shape.problem(100);
   UnloadOptions opt;
   opt.forward.newton.gradient_rel_tolerance = 1e-9;
   // Bounded (this test is about the verdict, not the cost): a failing forward solve is the
