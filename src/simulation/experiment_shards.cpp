@@ -35,14 +35,15 @@ void parse_shard(const std::string& text, int& k, int& n) {
 }
 
 std::string plan_fingerprint(const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,
-                             long model_vertices, long model_tetrahedra) {
+                             const PhantomModel& model) {
   std::ostringstream s;
   s.precision(17);
   s << opt.preset << '|' << opt.poisson_ratio << '|' << opt.density << '|' << opt.rest_shape << '|'
-    << model_vertices << '|' << model_tetrahedra << '|' << opt.simulation_cell_size << '|'
+    << model.rest.V.rows() << '|' << model.rest.T.rows() << '|' << opt.simulation_cell_size << '|'
     << to_string(opt.method_volume_form) << '|' << opt.method_nodal_element_share << '|' << opt.method_nodal_fallback << '|' << opt.method_stiffness_budget << '|'
     << (opt.given_configurations ? "given" : "generated") << '|';
   for (double e : opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli) s << e << ',';
+  for (const auto& r : model.method_regions) s << '|' << r.name << ':' << r.label << ':' << r.relative_stiffness;
   for (const auto& r : runs) s << '|' << r.experiment << ':' << r.setting << ':' << r.variable << '=' << r.value;
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a
   for (unsigned char c : s.str()) {

@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
     write_experiment_csv_header(csv);
     if (opt.shards > 1)
       write_shard_info(out_dir, opt.shard, opt.shards,
-                       plan_fingerprint(opt, runs, static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows())));
+                       plan_fingerprint(opt, runs, model));
     long rows = 0, failed = 0;
     run_experiments(
         model, opt, runs,

@@ -414,8 +414,7 @@ std::string suite_csv(const ExperimentSuiteOptions& o, const std::string& dir) {
   });
   if (o.shards > 1)
     write_shard_info(dir, o.shard, o.shards,
-                     plan_fingerprint(o, plan_experiments(o), static_cast<long>(coarse_phantom().rest.V.rows()),
-                                      static_cast<long>(coarse_phantom().rest.T.rows())));
+                     plan_fingerprint(o, plan_experiments(o), coarse_phantom()));
   csv.close();
   std::ifstream in(dir + "/results.csv");
   std::stringstream all;

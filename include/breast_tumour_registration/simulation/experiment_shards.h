@@ -13,6 +13,7 @@
 namespace btr {
 
 struct ExperimentSuiteOptions;
+struct PhantomModel;
 struct ExperimentRun;
 
 struct ShardRange {
@@ -26,9 +27,10 @@ ShardRange shard_range(size_t items, int k, int n);
 /// Parses "K/N" (e.g. "3/8"). Throws InputError naming the expected form.
 void parse_shard(const std::string& text, int& k, int& n);
 
-/// A fingerprint of the study: the runs, the moduli, the preset and options, and the model's size.
+/// A fingerprint of the study: the runs, the moduli, the preset and options, and the model's size
+/// and tissue regions.
 std::string plan_fingerprint(const ExperimentSuiteOptions& opt, const std::vector<ExperimentRun>& runs,
-                             long model_vertices, long model_tetrahedra);
+                             const PhantomModel& model);
 
 /// Writes dir/shard.txt for share k of n.
 void write_shard_info(const std::string& dir, int k, int n, const std::string& fingerprint);
