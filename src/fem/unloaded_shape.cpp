@@ -218,8 +218,9 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
       }
     }
     if (!result.converged)
-      result.reason = std::string(spent() ? budget_spent + ": " : "") + "neither directly nor by load continuation (" + std::to_string(res.continuation_stages) +
-                      " stages, reached " + std::to_string(static_cast<int>(std::lround(s * 100))) + " % of the gravity" +
+      result.reason = (spent() ? budget_spent + ": " : std::string()) + "neither directly nor by load continuation (" +
+                      std::to_string(res.continuation_stages) + " stages, reached " +
+                      std::to_string(static_cast<int>(std::lround(s * 100))) + " % of the gravity" +
                       (failure.empty() ? "" : "; last failure " + failure) + "): " + result.reason;
   }
   res.load_steps = phi.load_steps();

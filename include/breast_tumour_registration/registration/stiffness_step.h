@@ -46,8 +46,8 @@ struct StiffnessOptions {
   /// A candidate's unload may take at most max(min_candidate_forward_solves,
   /// candidate_budget_factor x the most forward solves a simulated candidate took so far);
   /// past it the candidate counts as one that cannot be simulated (as above). Candidates that
-  /// converge take 2 to 12 here; one that continuation cannot carry took 193 (a minute) before
-  /// failing anyway. 0: no budget.
+  /// converge took 2 to 13 on the bodies measured; one that continuation could not carry took
+  /// 194 (a minute) before failing anyway. 0: no budget.
   double candidate_budget_factor = 4;
   int min_candidate_forward_solves = 30;
   UnloadOptions unload;               ///< of every candidate's unload, and of the chosen one's finish
