@@ -179,7 +179,10 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   if (!pb.initial_rest) {
     Points lifted = xp;
     if (forward(xp, lifted, -pb.gravity)) {
-      X0 = lifted;
+      // A forward solve may end with a few elements inverted (its allowance); a rest shape may
+      // not, so such a lift is no start (the estimate would keep them, and every later solve
+      // on that rest shape would refuse it).
+      if (count_inverted(lifted, loaded.T) == 0) X0 = lifted;
       res.inverse_gravity_lift = max_row_norm(lifted - xp);
     }
   }
@@ -200,7 +203,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
         if (count_inverted(init, loaded.T) > 0) init = X_s;
       } else {
         Points lifted = xp;
-        if (forward(xp, lifted, -next * pb.gravity)) init = lifted;
+        if (forward(xp, lifted, -next * pb.gravity) && count_inverted(lifted, loaded.T) == 0) init = lifted;
       }
       Stage st = fixed_point(next, init, next < 1 ? opt.stage_tolerance : opt.tolerance);
       ++res.continuation_stages;
