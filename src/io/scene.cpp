@@ -337,9 +337,7 @@ Scene load_scene_fields(const std::string& path) {
         mr.youngs_modulus = k * s.material.youngs_modulus;
       }
       if (r["label"]) {
-        const double l = c.number(r["label"], f + ".label");
-        if (l != std::round(l) || std::abs(l) > 1e9) c.fail(f + ".label", "expected an integer cell label");
-        mr.label = static_cast<int>(l);
+        mr.label = c.cell_label(r["label"], f + ".label");
         by_label = true;
       }
       if (r["surface"])

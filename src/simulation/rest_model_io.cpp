@@ -95,9 +95,7 @@ PhantomModel load_rest_model_fields(const std::string& path) {
         c.fail(f, "expected {name, label, relative_stiffness}: a cell label of rest and its stiffness relative to the method's E");
       PhantomModel::MethodRegion mr;
       mr.name = c.text(r["name"], f + ".name");
-      const double l = c.number(r["label"], f + ".label");
-      if (l != std::round(l) || std::abs(l) > 1e9) c.fail(f + ".label", "expected an integer cell label");
-      mr.label = static_cast<int>(l);
+      mr.label = c.cell_label(r["label"], f + ".label");
       if (std::find(m.rest_labels.begin(), m.rest_labels.end(), mr.label) == m.rest_labels.end())
         c.fail(f + ".label", "no tetrahedron of rest carries the label " + std::to_string(mr.label));
       mr.relative_stiffness = c.number(r["relative_stiffness"], f + ".relative_stiffness");

@@ -4,6 +4,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -63,6 +64,13 @@ struct YamlFields {
     }
   }
   double number(const YAML::Node& n, const std::string& field) const { return scalar<double>(n, field, "a number"); }
+  /// An integer cell label (a mesh's tissue label); a fraction or a value past 1e9 is an error
+  /// naming the field.
+  int cell_label(const YAML::Node& n, const std::string& field) const {
+    const double l = number(n, field);
+    if (l != std::round(l) || std::abs(l) > 1e9) fail(field, "expected an integer cell label");
+    return static_cast<int>(l);
+  }
   /// true or false (YAML's spellings of them); anything else is an error naming the field.
   bool boolean(const YAML::Node& n, const std::string& field) const { return scalar<bool>(n, field, "true or false"); }
   Vec3 vec3(const YAML::Node& n, const std::string& field) const {
