@@ -11,6 +11,10 @@ small-strain limit. The tissue is heterogeneous: fat, a fibroglandular core (an 
 Newton without line search) from the rest shape to the prone (+z) and the supine (-z)
 equilibrium with the chest wall (z = 0) fixed.
 
+Is that truth converged? --order 3 solves the same mesh with cubic tetrahedra (P3), --refine K
+meshes a K times finer skin surface (the same landmarks); bench/compare_truths.py measures how
+far two truths of one body disagree (BENCHMARKS.md, "Is the independent truth converged?").
+
 For every fat modulus it writes OUT/E<fat E>/ with what a user of the package would have:
 the prone skin surface (prone.obj: the method meshes it itself, with CGAL), the chest-wall
 and landmark indices of that surface, the supine landmark positions, the supine skin surface,
@@ -38,7 +42,7 @@ BENCHMARKS.md ("The nodal volume term as the default"):
   --depth 75 --half-width 65 60 --half-height 60 --sag -10 --gland-ratio 3 --tumour-ratio 8
 
 Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
-       [--max-volume 1500] [--poisson-ratio 0.49] [--linear-solver auto|mumps|scipy]
+       [--max-volume 1500] [--order 2|3] [--refine 1] [--poisson-ratio 0.49] [--linear-solver auto|mumps|scipy]
        [--depth 60] [--half-width 85 70] [--half-height 65] [--sag 15] (lengths in mm, as
        bench/make_shape_model.py) [--gland-ratio 2] [--tumour-ratio 6]
        (needs Debian's python3-sfepy and tetgen; python3-petsc4py for MUMPS)"""
@@ -64,8 +68,9 @@ G = 9.81
 RHO = 1000.0
 
 
-def mesh_body(out, max_volume, a=60.0, bp=85.0, bm=70.0, c=65.0, s=15.0):
-    V, F, rings = surface(a, bp, bm, c, s)
+def mesh_body(out, max_volume, a=60.0, bp=85.0, bm=70.0, c=65.0, s=15.0, refine=1):
+    # refine K: K times the rings and points per ring, the same landmarks (one ring of K stays).
+    V, F, rings = surface(a, bp, bm, c, s, n_phi=40 * refine, n_theta=12 * refine, n_base=8 * refine)
     off = os.path.join(out, 'body.off')
     with open(off, 'w') as f:
         f.write('OFF\n%d %d 0\n' % (len(V), len(F)))
@@ -77,7 +82,7 @@ def mesh_body(out, max_volume, a=60.0, bp=85.0, bm=70.0, c=65.0, s=15.0):
     d = np.einsum('ij,ij->i', np.cross(node[ele[:, 1]] - node[ele[:, 0]], node[ele[:, 2]] - node[ele[:, 0]]),
                   node[ele[:, 3]] - node[ele[:, 0]])
     ele[d < 0] = ele[d < 0][:, [0, 2, 1, 3]]
-    ring = rings[len(rings) * 5 // 9]
+    ring = rings[(len(rings) // refine * 5 // 9 + 1) * refine - 1]  # 52.5 deg from the apex
     n_phi = len(ring)
     landmarks = {'C': 0, 'O1': ring[0], 'O2': ring[n_phi // 4], 'O3': ring[n_phi // 2], 'O4': ring[3 * n_phi // 4]}
     tumours = {'central': (0, -0.15 * c, 0.45 * a), 'lateral': (0.45 * bp, 0, 0.3 * a), 'upper': (0, 0.5 * c, 0.25 * a),
@@ -187,7 +192,7 @@ def write_truth_list(out, names):
 class Body:
     """The SfePy problem on the rest mesh [m]: P2 displacement, per-region materials."""
 
-    def __init__(self, node_m, ele, lab, moduli, nu, linear_solver='auto'):
+    def __init__(self, node_m, ele, lab, moduli, nu, linear_solver='auto', order=2):
         from sfepy.base.base import IndexedStruct, output
         from sfepy.discrete import Equation, Equations, FieldVariable, Function, Integral, Material, Problem
         from sfepy.discrete.conditions import Conditions, EssentialBC
@@ -199,10 +204,10 @@ class Body:
         domain = FEDomain('domain', mesh)
         omega = domain.create_region('Omega', 'all')
         chest = domain.create_region('Chest', 'vertices in (z < 1e-9)', 'facet')
-        field = Field.from_args('displacement', np.float64, 'vector', omega, approx_order=2)
+        field = Field.from_args('displacement', np.float64, 'vector', omega, approx_order=order)
         self.u = FieldVariable('u', 'unknown', field)
         v = FieldVariable('v', 'test', field, primary_var_name='u')
-        integral = Integral('i', order=4)
+        integral = Integral('i', order=2 * order)
         self.g = np.zeros(3)
 
         def force(ts, coors, mode=None, **kwargs):
@@ -296,6 +301,10 @@ def main():
     ap.add_argument('out')
     ap.add_argument('--fat-youngs-moduli', type=float, nargs='+', default=[300, 1000, 3400])
     ap.add_argument('--max-volume', type=float, default=1500, help='TetGen -a bound [mm^3]')
+    ap.add_argument('--order', type=int, choices=(2, 3), default=2,
+                    help='the displacement field: quadratic (P2) or cubic (P3) tetrahedra')
+    ap.add_argument('--refine', type=int, default=1,
+                    help='K times the skin surface\'s rings and points per ring (pass --max-volume / K^3 with it)')
     ap.add_argument('--poisson-ratio', type=float, default=0.49)
     ap.add_argument('--gland-ratio', type=float, default=2.0)
     ap.add_argument('--tumour-ratio', type=float, default=6.0)
@@ -308,7 +317,7 @@ def main():
     o = ap.parse_args()
     os.makedirs(o.out, exist_ok=True)
     node, ele, landmarks, tumours, gland, dims = mesh_body(o.out, o.max_volume, o.depth, o.half_width[0], o.half_width[1],
-                                                       o.half_height, o.sag)
+                                                       o.half_height, o.sag, o.refine)
     radius = 8.0
     lab = labels(node, ele, tumours, gland, radius)
     bface = boundary(ele)
@@ -329,10 +338,11 @@ def main():
     for fat in o.fat_youngs_moduli:
         t0 = time.time()
         moduli = {1: fat, 2: o.gland_ratio * fat, 3: o.tumour_ratio * fat}
-        body = Body(node_m, ele, lab, moduli, o.poisson_ratio, o.linear_solver)
+        body = Body(node_m, ele, lab, moduli, o.poisson_ratio, o.linear_solver, o.order)
         d = os.path.join(o.out, 'E%g' % fat)
         os.makedirs(d, exist_ok=True)
-        info = {'generator': 'SfePy (P2 tetrahedra, TL neo-Hookean + bulk penalty), TetGen mesh',
+        info = {'generator': 'SfePy (P%d tetrahedra, TL neo-Hookean + bulk penalty), TetGen mesh' % o.order,
+                'order': o.order, 'refine': o.refine,
                 'fat_youngs_modulus_Pa': fat, 'gland_youngs_modulus_Pa': moduli[2], 'tumour_youngs_modulus_Pa': moduli[3],
                 'poisson_ratio': o.poisson_ratio, 'vertices': int(len(node)), 'tetrahedra': int(len(ele)),
                 'shape_mm': dict(zip(('depth', 'half_width_plus_x', 'half_width_minus_x', 'half_height', 'sag'), dims))}
