@@ -54,7 +54,12 @@ int main(int argc, char** argv) {
     Scene without_unload = scene;
     without_unload.prone_gravity.reset();
     RegistrationModel rm = prepare_model(without_unload, warnings);
-    if (scene.prone_gravity && unloads_in_preparation(scene)) unload_model(rm, *scene.prone_gravity);
+    if (scene.prone_gravity && unloads_in_preparation(scene)) {
+      const StepReport u = unload_model(rm, *scene.prone_gravity);
+      std::printf("unload: %s (%s), rest shape moved up to %.2f mm, re-simulated prone within %.4f mm\n",
+                  u.converged ? "converged" : "NOT converged", u.stop_reason.c_str(), u.unload.rest_change * 1e3,
+                  u.unload.mismatch * 1e3);
+    }
     const long tets = rm.rest.T.rows();
     RegistrationEngine engine(scene, std::move(rm), std::move(warnings));
     const RegistrationResult r = engine.solve(preset_options("balanced"));
