@@ -1,11 +1,11 @@
 // How far our FEM's forward answer lies from another code's truth, with nothing estimated:
 // the true rest shape, the true fat E and tissue layout, supine gravity only (the step
 // `gravity`), on the model's own mesh and re-meshed at each cell size given. What is left is
-// discretization (linear against SfePy's quadratic tetrahedra) and the material law, the floor
+// discretization (linear against SfePy's quadratic or cubic tetrahedra) and the material law, the floor
 // under any registration of that truth. Build against the package's libraries (after
 // scripts/setup.sh):
-//   L=build/ws/devel/lib; g++ -std=c++17 -O2 -Iinclude -I/usr/include/eigen3 bench/probes/forward_discrepancy.cpp \
-//     -o /tmp/fwd -L$L -lbtr_simulation -lbtr_registration -lbtr_io -lbtr_geometry -lbtr_fem -lbtr_base -Wl,-rpath,$PWD/$L
+//   L=build/ws/devel/lib
+//   g++ -std=c++17 -O2 -Iinclude -I/usr/include/eigen3 bench/probes/forward_discrepancy.cpp -o /tmp/fwd -L$L -lbtr_simulation -lbtr_registration -lbtr_io -lbtr_geometry -lbtr_fem -lbtr_base -Wl,-rpath,$PWD/$L
 //   cd TRUTH && /tmp/fwd model_regions.yaml truth.yaml 300 element|nodal 0 7 5 4   # 0: the model's own mesh
 // PROBE_STEPS=full runs the whole default plan on the supine data instead of gravity alone, and
 // PROBE_REST=unloaded|estimated starts from the unloaded shape at the true E or at an E estimated
