@@ -11,7 +11,8 @@
 // PROBE_REST=unloaded|estimated starts from the unloaded shape at the true E or at an E estimated
 // from the landmarks (the suite's settings), so that each estimate's share of the error shows.
 // PROBE_POSE=prone simulates the prone pose from the true rest shape instead (the forward model
-// the unloaded shape inverts), measured on the prone tumours.
+// the unloaded shape inverts), measured on the prone tumours. PROBE_SAG=1 also prints how far each
+// tumour moved from its rest position here and in the truth.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -73,6 +74,12 @@ int main(int argc, char** argv) {
     }
     if (r.estimated_youngs_modulus > 0) std::printf("  (E estimated %.0f Pa)", r.estimated_youngs_modulus);
     std::printf("  worst %.2f mm\n", worst);
+    if (std::getenv("PROBE_SAG"))  // how far each tumour moved here and in the truth (rest as given: vertex mean)
+      for (size_t i = 0; i < r.tumours.size(); ++i) {
+        const Vec3 c0 = scene.tumours[i].prone.V.colwise().mean().transpose();
+        std::printf("  %s moved %.2f mm here, %.2f mm in the truth\n", r.tumours[i].name.c_str(),
+                    (r.tumours[i].centroid - c0).norm() * 1e3, r.tumours[i].rigid_centroid_distance * 1e3);
+      }
     for (const auto& rep : r.reports)
       if (!rep.converged) std::printf("  %s: %s (%ld inverted)\n", rep.name.c_str(), rep.stop_reason.c_str(), long(rep.inverted));
     std::fflush(stdout);
