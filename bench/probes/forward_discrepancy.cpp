@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   run.experiment = "forward";
   const char* rest = std::getenv("PROBE_REST");
   const char* steps = std::getenv("PROBE_STEPS");
+  const char* pose = std::getenv("PROBE_POSE");
   run.rest_shape = rest ? rest : "rest";
   run.method_youngs_modulus = E;
   if (!(steps && std::string(steps) == "full")) run.steps = {"gravity"};
@@ -43,7 +44,6 @@ int main(int argc, char** argv) {
     Scene scene = experiment_scene(model, conf, run, "balanced", run.rest_shape);
     scene.material.volume_form = std::string(argv[4]) == "nodal" ? VolumeForm::Nodal : VolumeForm::Element;
     scene.nodal_fallback = false;
-    const char* pose = std::getenv("PROBE_POSE");
     if (pose && std::string(pose) == "prone") {
       scene.gravity = model.prone_gravity;
       for (auto& t : scene.tumours) t.supine_ground_truth = conf.tumour_prone.at(t.name);
@@ -51,12 +51,9 @@ int main(int argc, char** argv) {
     if (h > 0) scene = with_simulation_mesh(scene, h * 1e-3);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::string> warnings;
-    // As the suite: this mesh, whatever the preset's, and the unload before the engine.
-    Scene without_unload = scene;
-    without_unload.prone_gravity.reset();
-    RegistrationModel rm = prepare_model(without_unload, warnings);
-    if (scene.prone_gravity && unloads_in_preparation(scene)) {
-      const StepReport u = unload_model(rm, *scene.prone_gravity);
+    RegistrationModel rm = prepare_model(scene, warnings);  // as the suite: this mesh, whatever the preset's
+    if (rm.unload) {  // prepare_model unloads where the plan does (not when E is estimated)
+      const StepReport& u = *rm.unload;
       std::printf("unload: %s (%s), rest shape moved up to %.2f mm, re-simulated prone within %.4f mm\n",
                   u.converged ? "converged" : "NOT converged", u.stop_reason.c_str(), u.unload.rest_change * 1e3,
                   u.unload.mismatch * 1e3);
