@@ -12,6 +12,7 @@
 
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
+#include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 
 namespace btr {
 
@@ -36,6 +37,13 @@ struct ForwardGravityOptions {
   /// load is not retried as it was); below min_load_fraction the solve has failed.
   double first_load_fraction = 0.25;
   double min_load_fraction = 1.0 / 64;
+  /// Linear or quadratic elements. Quadratic: the rest shape and the loaded shape given and
+  /// returned are still the linear mesh's vertices, the rest straight-sided; the edge nodes stay
+  /// inside (each solve starts them from the last converged one's bulge; quadratic_nodes() gives
+  /// them), the volume term is the element's at the quadrature points (volume_form and the
+  /// nodal element share do not apply) and a shared solver is not used (another pattern).
+  ElementOrder element_order = ElementOrder::Linear;
+  int quadrature_degree = 5;  ///< quadratic elements: tet_quadrature(2 or 5)
 };
 
 class ForwardGravity {
@@ -60,9 +68,14 @@ class ForwardGravity {
   int load_steps() const { return load_steps_; }                ///< continuation fractions solved, over all solves
   /// Every continuation step tried, in order, over all solves: (load fraction, converged).
   const std::vector<std::pair<double, bool>>& continuation_steps() const { return continuation_steps_; }
+  /// Quadratic elements: the mesh and every node's position at the last converged solve (corners
+  /// first, then edge nodes), for evaluating the quadratic field (quadratic_interpolate).
+  const QuadraticTetMesh& quadratic_mesh() const { return quadratic_; }
+  const Points& quadratic_nodes() const { return quadratic_x_; }
 
  private:
   NewtonResult solve_once(const Points& X, const Vec3& gravity, Points& x);
+  NewtonResult solve_once_quadratic(const Points& X, const Vec3& gravity, Points& x);
 
   TetMesh rest_;
   std::vector<bool> fixed_;
@@ -76,6 +89,10 @@ class ForwardGravity {
   NewtonSolver* solver_ = nullptr;  ///< own_, or the shared one
   int newton_iterations_ = 0, load_steps_ = 0;
   std::vector<std::pair<double, bool>> continuation_steps_;
+  QuadraticTetMesh quadratic_;
+  std::vector<bool> quadratic_fixed_;
+  Points bulge_;        ///< per edge node: its offset from its edge's midpoint at the last converged solve
+  Points quadratic_x_;  ///< every node at the last converged solve
 };
 
 }  // namespace btr

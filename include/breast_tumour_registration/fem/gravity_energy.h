@@ -10,6 +10,8 @@ class GravityEnergy : public EnergyTerm {
  public:
   /// rest      rest mesh (masses); density [kg/m^3]; gravity acceleration vector [m/s^2]
   GravityEnergy(const TetMesh& rest, double density, const Vec3& gravity);
+  /// Given nodal masses [kg] (e.g. a quadratic mesh's consistent ones, some negative).
+  GravityEnergy(Eigen::VectorXd masses, const Vec3& gravity);
   std::string name() const override { return "gravity"; }
   double value(const Points& x) const override;
   void add_gradient(const Points& x, Eigen::VectorXd& g) const override;

@@ -1,0 +1,61 @@
+// The stable Neo-Hookean energy of quadratic (10-node) tetrahedra, integrated by a symmetric
+// quadrature rule: E = sum_t vol_t sum_q w_q psi(F_q), F_q = sum_a x_a (grad N_a(b_q))^T.
+// The positions are the quadratic mesh's nodes (corners first, then edge nodes,
+// quadratic_tetrahedra.h); the rest shape is straight-sided. The projected Hessian clamps each
+// quadrature point's d2psi/dF2 (positive weights keep the sum PSD).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "breast_tumour_registration/fem/energy_term.h"
+#include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
+#include "breast_tumour_registration/fem/stable_neo_hookean.h"
+
+namespace btr {
+
+using Vec30 = Eigen::Matrix<double, 30, 1>;
+using Mat30 = Eigen::Matrix<double, 30, 30>;
+
+class QuadraticElasticEnergy : public EnergyTerm {
+ public:
+  /// rest_corners  the linear mesh's rest vertex positions (the edge nodes at midpoints)
+  /// materials, material_of  as ElasticEnergy's (per element)
+  /// quadrature_degree  2 (4 points) or 5 (14 points), tet_quadrature
+  /// Throws InputError on a degenerate or inverted rest element.
+  QuadraticElasticEnergy(const QuadraticTetMesh& mesh, const Points& rest_corners,
+                         std::vector<StableNeoHookean> materials, std::vector<int> material_of = {},
+                         int quadrature_degree = 5);
+
+  std::string name() const override { return "elastic_p2"; }
+  double value(const Points& x) const override;
+  void add_gradient(const Points& x, Eigen::VectorXd& g) const override;
+  void add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const override;
+  /// The 10 nodes of every element.
+  std::vector<std::vector<int>> hessian_cliques() const override;
+
+  double element_value(const Points& x, Eigen::Index t) const;
+  Vec30 element_gradient(const Points& x, Eigen::Index t) const;
+  Mat30 element_hessian(const Points& x, Eigen::Index t, bool project_psd) const;
+
+  /// Consistent nodal masses [kg] of a uniform density: the integral of density times each shape
+  /// function (a corner's is negative, -1/20 of its element's mass; an edge node's 1/5).
+  Eigen::VectorXd consistent_masses(double density) const;
+
+ private:
+  Eigen::Matrix<double, 10, 3> shape_gradients(Eigen::Index t, size_t q) const;
+
+  QuadraticTets T_;
+  Eigen::Index nodes_;
+  std::vector<Eigen::Matrix<double, 4, 3>> barycentric_gradients_;  ///< per element
+  std::vector<double> volume_;
+  std::vector<StableNeoHookean> materials_;
+  std::vector<int> material_of_;
+  std::vector<TetQuadraturePoint> rule_;
+  std::vector<Eigen::Matrix<double, 10, 4>> shape_derivatives_;  ///< per quadrature point
+  mutable unsigned long scatter_for_ = 0;
+  mutable std::vector<long> offsets_;  ///< 100 per element, -1 where a node is fixed
+  mutable std::vector<long> strides_;  ///< 10 per element
+};
+
+}  // namespace btr
