@@ -12,7 +12,8 @@
 // from the landmarks (the suite's settings), so that each estimate's share of the error shows.
 // PROBE_POSE=prone simulates the prone pose from the true rest shape instead (the forward model
 // the unloaded shape inverts), measured on the prone tumours. PROBE_SAG=1 also prints how far each
-// tumour moved from its rest position here and in the truth.
+// tumour moved from its rest position here and in the truth. PROBE_UNLOAD_ORDER=quadratic unloads
+// (and searches the stiffness) with quadratic elements (material.unload_element_order).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -44,6 +45,7 @@ int main(int argc, char** argv) {
     Scene scene = experiment_scene(model, conf, run, "balanced", run.rest_shape);
     scene.material.volume_form = std::string(argv[4]) == "nodal" ? VolumeForm::Nodal : VolumeForm::Element;
     scene.nodal_fallback = false;
+    if (const char* order = std::getenv("PROBE_UNLOAD_ORDER")) scene.material.unload_element_order = parse_element_order(order);
     if (pose && std::string(pose) == "prone") {
       scene.gravity = model.prone_gravity;
       for (auto& t : scene.tumours) t.supine_ground_truth = conf.tumour_prone.at(t.name);

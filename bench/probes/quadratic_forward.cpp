@@ -31,6 +31,7 @@ struct Model {
   VolumeForm form;
   ElementOrder order;
   int degree;
+  QuadraticVolume volume;
 };
 
 // Tumour vertex positions under node positions x (corners; plus edge nodes when quadratic).
@@ -63,10 +64,17 @@ int main(int argc, char** argv) {
   const PhantomModel model = load_rest_model(argv[1]);
   const double E = std::atof(argv[3]);
   const PhantomConfigurations conf = load_given_configurations(argv[2], model).at(E);
-  const Model models[] = {{"linear element", VolumeForm::Element, ElementOrder::Linear, 0},
-                          {"linear nodal", VolumeForm::Nodal, ElementOrder::Linear, 0},
-                          {"quadratic, 4 points", VolumeForm::Element, ElementOrder::Quadratic, 2},
-                          {"quadratic, 14 points", VolumeForm::Element, ElementOrder::Quadratic, 5}};
+  const QuadraticVolume Q = QuadraticVolume::Quadrature, M = QuadraticVolume::ElementMean;
+  const std::vector<Model> all = {{"linear element", VolumeForm::Element, ElementOrder::Linear, 0, Q},
+                                  {"linear nodal", VolumeForm::Nodal, ElementOrder::Linear, 0, Q},
+                                  {"quadratic, 4 points", VolumeForm::Element, ElementOrder::Quadratic, 2, Q},
+                                  {"quadratic, 14 points", VolumeForm::Element, ElementOrder::Quadratic, 5, Q},
+                                  {"quadratic mean, 14 p.", VolumeForm::Element, ElementOrder::Quadratic, 5, M}};
+  // PROBE_MODELS=0,1,4 runs those rows only (default: all).
+  std::vector<Model> models;
+  const std::string only = std::getenv("PROBE_MODELS") ? std::getenv("PROBE_MODELS") : "";
+  for (size_t i = 0; i < all.size(); ++i)
+    if (only.empty() || ("," + only + ",").find("," + std::to_string(i) + ",") != std::string::npos) models.push_back(all[i]);
   for (int a = 4; a < argc; ++a) {
     const double h = std::atof(argv[a]) * 1e-3;
     ExperimentRun run;
@@ -84,6 +92,7 @@ int main(int argc, char** argv) {
       ForwardGravityOptions fo;
       fo.element_order = m.order;
       fo.quadrature_degree = std::max(2, m.degree);
+      fo.quadratic_volume = m.volume;
       fo.newton.gradient_rel_tolerance = 1e-8;
       auto phi = [&](const RegistrationModel& r) {
         return ForwardGravity(r.rest.T, r.rest.V.rows(), r.chest_wall, r.materials, r.material_of, m.form, 0,
@@ -101,6 +110,7 @@ int main(int argc, char** argv) {
 
       // Unload the prone image with this model, then supine gravity from the estimate.
       t0 = std::chrono::steady_clock::now();
+      try {
       const TetMesh loaded{pm.prone, pm.rest.T};
       UnloadProblem pb = unload_problem(pm, loaded, model.prone_gravity);
       pb.volume_form = m.form;
@@ -119,6 +129,9 @@ int main(int argc, char** argv) {
                   "%d forward solves, mismatch %.4f mm)\n",
                   m.name, prone, supine, unload, tp, u.converged ? "converged" : "NOT converged", tu, u.iterations,
                   u.max_mismatch * 1e3);
+      } catch (const std::exception& ex) {
+        std::printf("  %-22s prone %.2f  supine %.2f  (prone solve %.1f s; unload: %s)\n", m.name, prone, supine, tp, ex.what());
+      }
       std::fflush(stdout);
     }
   }

@@ -72,7 +72,8 @@ NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Po
 NewtonResult ForwardGravity::solve_once_quadratic(const Points& X, const Vec3& gravity, Points& x) {
   const Eigen::Index nc = quadratic_.corners;
   TotalEnergy energy;
-  auto elastic = std::make_shared<QuadraticElasticEnergy>(quadratic_, X, materials_, material_of_, opt_.quadrature_degree);
+  auto elastic = std::make_shared<QuadraticElasticEnergy>(quadratic_, X, materials_, material_of_, opt_.quadrature_degree,
+                                                          opt_.quadratic_volume);
   auto g = std::make_shared<GravityEnergy>(elastic->consistent_masses(density_), gravity);
   energy.add(elastic);
   energy.add(g);

@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/material_region.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
+#include "breast_tumour_registration/fem/element_order.h"
 #include "breast_tumour_registration/fem/volume_form.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/surface_orientation.h"
@@ -44,7 +45,7 @@ const std::vector<std::string> kSceneKeys = {
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmarks.prone", "landmarks.supine", "patient_frame", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.denoise", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
-    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "material.nodal_element_share", "material.nodal_fallback", "regions", "regions[]",
+    "material.youngs_modulus", "material.youngs_modulus_range", "material.poisson_ratio", "material.density", "material.volume_form", "material.nodal_element_share", "material.nodal_fallback", "material.unload_element_order", "regions", "regions[]",
     "regions[].name", "regions[].youngs_modulus", "regions[].relative_stiffness", "regions[].label", "regions[].surface", "prone.cell_labels", "tumour_material",
     "tumour_material.youngs_modulus", "gravity", "prone_gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
     "misalignment.translation_mm", "uncertainty", "uncertainty.youngs_modulus_range", "uncertainty.poisson_ratio_range",
@@ -305,6 +306,11 @@ Scene load_scene_fields(const std::string& path) {
     if (m["volume_form"])
       c.load("material.volume_form", [&] {
         s.material.volume_form = parse_volume_form(c.text(m["volume_form"], "material.volume_form"));
+        return 0;
+      });
+    if (m["unload_element_order"])
+      c.load("material.unload_element_order", [&] {
+        s.material.unload_element_order = parse_element_order(c.text(m["unload_element_order"], "material.unload_element_order"));
         return 0;
       });
     if (m["nodal_fallback"]) s.nodal_fallback = c.boolean(m["nodal_fallback"], "material.nodal_fallback");

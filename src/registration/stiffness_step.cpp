@@ -72,8 +72,10 @@ void set_poisson_ratio(RegistrationModel& model, double nu) {
 
 StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3& prone_gravity,
                                      const std::vector<Anchor>& anchors, const Points& supine,
-                                     const StiffnessOptions& opt, StepSolvers* cache) {
+                                     const StiffnessOptions& options, StepSolvers* cache) {
   const auto t0 = std::chrono::steady_clock::now();
+  StiffnessOptions opt = options;  // the unload's and the supine solves' elements are the model's
+  opt.unload = with_model_elements(options.unload, model);
   if (anchors.size() < 3 || supine.rows() != static_cast<Eigen::Index>(anchors.size()))
     throw InputError("stiffness: estimating the Young's modulus needs >= 3 landmark pairs, got " +
                      std::to_string(std::min<size_t>(anchors.size(), static_cast<size_t>(supine.rows()))));

@@ -46,6 +46,11 @@ StepReport unload_report(const UnloadResult& u, const Points& prone) {
   return rep;
 }
 
+UnloadOptions with_model_elements(UnloadOptions options, const RegistrationModel& model) {
+  options.forward.element_order = model.material.unload_element_order;
+  return options;
+}
+
 StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options,
                         StepSolvers* cache) {
   if (!prone_gravity.allFinite() || !(prone_gravity.norm() > 0))
@@ -53,7 +58,7 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
   const TetMesh loaded{model.prone, model.rest.T};
   UnloadProblem pb = unload_problem(model, loaded, prone_gravity);
   if (cache) pb.solver = &cache->gravity(model);
-  const UnloadResult u = estimate_unloaded_shape(pb, options);
+  const UnloadResult u = estimate_unloaded_shape(pb, with_model_elements(options, model));
 
   StepReport rep = unload_report(u, model.prone);
   // The prone shape as rest misses the prone shape by about the sag; the estimate is kept when

@@ -293,6 +293,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           Scene scene = experiment_scene(model, conf, *run, opt.preset, opt.rest_shape);
           scene.material.volume_form = opt.method_volume_form;
           scene.material.nodal_element_share = opt.method_nodal_element_share;
+          scene.material.unload_element_order = opt.method_unload_element_order;
           scene.nodal_fallback = opt.method_nodal_fallback;
           if (opt.simulation_cell_size > 0) scene = with_simulation_mesh(scene, opt.simulation_cell_size);
           std::vector<std::string> warnings;

@@ -139,6 +139,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
   // Poisson's ratio, which set how far the same E lets the tissue sag.
   // Where the nodal form did not converge and the engine fell back, the element form's.
   j["material_model"] = {{"volume_form", to_string(r.volume_form)}, {"poisson_ratio", num(model.material.poisson_ratio)}};
+  if (model.material.unload_element_order != ElementOrder::Linear)
+    j["material_model"]["unload_element_order"] = to_string(model.material.unload_element_order);
   if (r.volume_form == VolumeForm::Nodal)
     j["material_model"]["nodal_element_share"] = num(model.material.nodal_element_share);
   if (const auto& f = r.volume_form_fallback)

@@ -55,6 +55,12 @@ int main(int argc, char** argv) {
                  "the generated truth keeps its own")
       ->check(CLI::IsMember({"auto", "element", "nodal"}))
       ->capture_default_str();
+  std::string unload_elements = "linear";
+  app.add_option("--unload-element-order", unload_elements,
+                 "the elements of the method's unloaded-shape estimate and stiffness search: linear or quadratic "
+                 "(material.unload_element_order; the registration steps stay linear)")
+      ->check(CLI::IsMember({"linear", "quadratic"}))
+      ->capture_default_str();
   double nodal_element_share = 0;
   app.add_option("--nodal-element-share", nodal_element_share,
                  "with the nodal volume term: the volume stiffness each tetrahedron keeps on its own volume "
@@ -115,6 +121,7 @@ int main(int argc, char** argv) {
     opt.simulation_cell_size = simulation_cell_mm * 1e-3;
     opt.method_volume_form = parse_volume_form(volume_form);
     opt.method_nodal_element_share = nodal_element_share;
+    opt.method_unload_element_order = parse_element_order(unload_elements);
     opt.method_nodal_fallback = nodal_fallback == "on";
     opt.method_stiffness_budget = stiffness_budget;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};

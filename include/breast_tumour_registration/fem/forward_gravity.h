@@ -12,6 +12,7 @@
 
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
+#include "breast_tumour_registration/fem/quadratic_elastic_energy.h"
 #include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 
 namespace btr {
@@ -44,6 +45,7 @@ struct ForwardGravityOptions {
   /// nodal element share do not apply) and a shared solver is not used (another pattern).
   ElementOrder element_order = ElementOrder::Linear;
   int quadrature_degree = 5;  ///< quadratic elements: tet_quadrature(2 or 5)
+  QuadraticVolume quadratic_volume = QuadraticVolume::Quadrature;  ///< quadratic elements: where the volume term acts
 };
 
 class ForwardGravity {

@@ -2,6 +2,7 @@
 // by Young's modulus and Poisson's ratio, its density, and the form of its volume term.
 #pragma once
 
+#include "breast_tumour_registration/fem/element_order.h"
 #include "breast_tumour_registration/fem/volume_form.h"
 
 namespace btr {
@@ -16,6 +17,11 @@ struct MaterialParameters {
   /// trade (BENCHMARKS.md, "The nodal form with an element share"): 5 converges more of the
   /// suite's soft runs and costs 0.1 to 0.2 mm at fat 1000 Pa.
   double nodal_element_share = 0;
+  /// The elements of the unloaded-shape estimate and of the stiffness search's gravity solves
+  /// (the forward model the unload inverts; the registration steps stay linear). Quadratic:
+  /// measured against SfePy's cubic truth (BENCHMARKS.md, "A quadratic forward model for the
+  /// unload"), at several times the unload's cost.
+  ElementOrder unload_element_order = ElementOrder::Linear;
 };
 
 }  // namespace btr

@@ -17,11 +17,9 @@
 #include <vector>
 
 #include "breast_tumour_registration/base/types.h"
+#include "breast_tumour_registration/fem/element_order.h"
 
 namespace btr {
-
-/// Linear (4-node) or quadratic (10-node) tetrahedra.
-enum class ElementOrder { Linear, Quadratic };
 
 using QuadraticTets = Eigen::Matrix<int, Eigen::Dynamic, 10, Eigen::RowMajor>;
 using Vec4 = Eigen::Vector4d;

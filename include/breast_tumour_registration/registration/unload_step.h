@@ -25,6 +25,8 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
 
 /// The unload problem of `model`'s mesh, chest wall and materials for the imaged shape `loaded`
 /// (its vertices: model.prone, kept alive by the caller) under `gravity` [m/s^2].
+/// `options` with the model's elements for the forward solves (MaterialParameters::unload_element_order).
+UnloadOptions with_model_elements(UnloadOptions options, const RegistrationModel& model);
 UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity);
 
 /// The step report of an unload (name "unload"; mismatch, cost, and how far the rest shape
