@@ -5,8 +5,10 @@
 //   prone   gravity from the true rest shape, against the prone tumours (the forward model the
 //           unloaded shape inverts)
 //   supine  gravity from the true rest shape, against the supine tumours
-//   unload  the prone image unloaded at the true E with that model, then supine gravity from
-//           the estimate (no surface or landmark step), against the supine tumours
+//   rest    the prone image unloaded at the true E with that model: the tumours' rest centroids
+//           (carried by the estimate) against the true rest shape's
+//   unload  then supine gravity from the estimate (no surface or landmark step), against the
+//           supine tumours
 // Worst tumour centroid distance [mm] and seconds. Build against the package's libraries:
 //   L=build/ws/devel/lib
 //   g++ -std=c++17 -O2 -fopenmp -Iinclude -I/usr/include/eigen3 bench/probes/quadratic_forward.cpp -o /tmp/qfwd -L$L -lbtr_simulation -lbtr_registration -lbtr_io -lbtr_geometry -lbtr_fem -lbtr_base -Wl,-rpath,$PWD/$L
@@ -125,9 +127,14 @@ int main(int argc, char** argv) {
       Points xu = u.rest;
       g.solve(u.rest, pm.gravity, xu);
       const double unload = worst_error(pm, g, xu, conf.tumour_supine);
-      std::printf("  %-22s prone %.2f  supine %.2f  unload+supine %.2f mm  (prone solve %.1f s, unload %s in %.1f s, "
+      double rest = 0;  // the tumours' material points in the estimate, against their true rest positions
+      for (size_t i = 0; i < pm.tumours.size(); ++i) {
+        const SurfaceMesh s{apply_embedding(pm.tumours[i].embedding, pm.rest.T, u.rest), pm.tumours[i].prone.F};
+        rest = std::max(rest, (volume_centroid(s) - volume_centroid(rm.tumours.at(i).prone)).norm() * 1e3);
+      }
+      std::printf("  %-22s prone %.2f  supine %.2f  rest %.2f  unload+supine %.2f mm  (prone solve %.1f s, unload %s in %.1f s, "
                   "%d forward solves, mismatch %.4f mm)\n",
-                  m.name, prone, supine, unload, tp, u.converged ? "converged" : "NOT converged", tu, u.iterations,
+                  m.name, prone, supine, rest, unload, tp, u.converged ? "converged" : "NOT converged", tu, u.iterations,
                   u.max_mismatch * 1e3);
       } catch (const std::exception& ex) {
         std::printf("  %-22s prone %.2f  supine %.2f  (prone solve %.1f s; unload: %s)\n", m.name, prone, supine, tp, ex.what());

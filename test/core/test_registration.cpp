@@ -309,6 +309,26 @@ TEST(Unload, WithQuadraticElementsTheUnloadInvertsTheQuadraticModel) {
   EXPECT_TRUE(r.converged) << btr::test::step_stops(r);
 }
 
+// With E estimated the search compares its candidates with linear elements and unloads the
+// chosen one with quadratic ones: the same E, another rest shape, the report naming the elements.
+TEST(Stiffness, WithQuadraticUnloadTheChosenEIsUnloadedWithQuadraticElements) {
+  const std::string d = soft_phantom_dir("phantom12_soft_e");
+  const std::string estimate = "material: {youngs_modulus: estimate}\nprone_gravity: [0, 0, 9.81]";
+  const std::string quadratic = "material: {youngs_modulus: estimate, unload_element_order: quadratic}\nprone_gravity: [0, 0, 9.81]";
+  const RegistrationResult rl = register_scene(scene_with(estimate, "estimate_linear", d), preset_options("fast"));
+  const RegistrationResult rq = register_scene(scene_with(quadratic, "estimate_quadratic", d), preset_options("fast"));
+  ASSERT_GE(rq.reports.size(), 2u);
+  EXPECT_EQ(rq.reports[1].name, "unload");
+  EXPECT_TRUE(rq.reports[1].converged) << rq.reports[1].stop_reason;
+  EXPECT_NE(rq.reports[1].stop_reason.find("(quadratic elements)"), std::string::npos) << rq.reports[1].stop_reason;
+  EXPECT_EQ(rq.estimated_youngs_modulus, rl.estimated_youngs_modulus);
+  EXPECT_NE(rq.reports[1].unload.rest_change, rl.reports[1].unload.rest_change);
+  std::printf("600 Pa phantom, E estimated %.0f Pa: rest shape moved %.2f mm (linear unload), %.2f mm (quadratic); worst "
+              "tumour %.3f / %.3f mm\n", rq.estimated_youngs_modulus, rl.reports[1].unload.rest_change * 1e3,
+              rq.reports[1].unload.rest_change * 1e3, worst_error(rl) * 1e3, worst_error(rq) * 1e3);
+  EXPECT_TRUE(rq.converged) << btr::test::step_stops(rq);
+}
+
 // Issue 13: the unloaded shape needs the right stiffness. The method told 3400 Pa on a 600 Pa
 // breast, asked to estimate it: the estimate lands near the truth, the tumours within half a
 // millimetre; a range that excludes the truth is reported as a bound, not as converged.

@@ -17,10 +17,11 @@ struct MaterialParameters {
   /// trade (BENCHMARKS.md, "The nodal form with an element share"): 5 converges more of the
   /// suite's soft runs and costs 0.1 to 0.2 mm at fat 1000 Pa.
   double nodal_element_share = 0;
-  /// The elements of the unloaded-shape estimate and of the stiffness search's gravity solves
-  /// (the forward model the unload inverts; the registration steps stay linear). Quadratic:
-  /// measured against SfePy's cubic truth (BENCHMARKS.md, "A quadratic forward model for the
-  /// unload"), at several times the unload's cost.
+  /// The elements of the unloaded-shape estimate (the forward model the unload inverts; the
+  /// registration steps stay linear, and the stiffness search compares its candidates with
+  /// linear elements, then unloads the chosen E with these). Quadratic: measured against SfePy's
+  /// cubic truth (BENCHMARKS.md, "A quadratic forward model for the unload"), at several times
+  /// the unload's cost.
   ElementOrder unload_element_order = ElementOrder::Linear;
 };
 
