@@ -89,15 +89,16 @@ void HessianAssembler::scatter_add(const Eigen::VectorXd& reduced, double scale,
   for (int f = 0; f < num_free_; ++f) full.segment<3>(3 * free_vertex_[f]) += scale * reduced.segment<3>(3 * f);
 }
 
-void TetScatter::build(const HessianAssembler& H, const Tetrahedra& T) {
-  offsets_.assign(16 * T.rows(), -1);
-  strides_.assign(4 * T.rows(), 0);
+template <int N>
+void ElementScatter<N>::build(const HessianAssembler& H, const Elements& T) {
+  offsets_.assign(static_cast<size_t>(N * N * T.rows()), -1);
+  strides_.assign(static_cast<size_t>(N * T.rows()), 0);
   // In parallel (an energy whose material changes is rebuilt with its maps: 46 times in one
   // nodal-form registration with E estimated); block_offset throws for a pair outside the pattern.
   if (const std::exception_ptr failed = parallel_for_capturing(T.rows(), [&](Eigen::Index t) {
-        for (int b = 0; b < 4; ++b) {
-          if (!H.is_fixed(T(t, b))) strides_[4 * t + b] = H.column_stride(T(t, b));
-          for (int a = 0; a < 4; ++a) offsets_[16 * t + 4 * b + a] = H.block_offset(T(t, a), T(t, b));
+        for (int b = 0; b < N; ++b) {
+          if (!H.is_fixed(T(t, b))) strides_[N * t + b] = H.column_stride(T(t, b));
+          for (int a = 0; a < N; ++a) offsets_[N * N * t + N * b + a] = H.block_offset(T(t, a), T(t, b));
         }
       })) {
     id_ = 0;
@@ -106,12 +107,13 @@ void TetScatter::build(const HessianAssembler& H, const Tetrahedra& T) {
   id_ = H.id();
 }
 
-void TetScatter::add(HessianAssembler& H, Eigen::Index t, const Mat12& K) const {
+template <int N>
+void ElementScatter<N>::add(HessianAssembler& H, Eigen::Index t, const ElementMatrix& K) const {
   double* values = H.values();
-  for (int b = 0; b < 4; ++b) {
-    const long stride = strides_[4 * t + b];
-    for (int a = 0; a < 4; ++a) {
-      const long off = offsets_[16 * t + 4 * b + a];
+  for (int b = 0; b < N; ++b) {
+    const long stride = strides_[N * t + b];
+    for (int a = 0; a < N; ++a) {
+      const long off = offsets_[N * N * t + N * b + a];
       if (off < 0) continue;
       double* v = values + off;
       for (int k = 0; k < 3; ++k)
@@ -119,5 +121,8 @@ void TetScatter::add(HessianAssembler& H, Eigen::Index t, const Mat12& K) const 
     }
   }
 }
+
+template class ElementScatter<4>;
+template class ElementScatter<10>;
 
 }  // namespace btr

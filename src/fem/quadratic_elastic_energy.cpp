@@ -5,7 +5,6 @@
 #include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
-#include "breast_tumour_registration/base/parallel_for.h"
 #include "breast_tumour_registration/fem/determinant_eigensystem.h"
 #include "breast_tumour_registration/fem/material_assignment.h"
 #include "breast_tumour_registration/fem/small_matrices.h"
@@ -153,41 +152,15 @@ std::vector<std::vector<int>> QuadraticElasticEnergy::hessian_cliques() const {
 
 void QuadraticElasticEnergy::add_hessian(const Points& x, bool project_psd, HessianAssembler& H) const {
   const Eigen::Index nt = T_.rows();
-  if (scatter_for_ != H.id()) {
-    offsets_.assign(100 * nt, -1);
-    strides_.assign(10 * nt, 0);
-    if (const std::exception_ptr failed = parallel_for_capturing(nt, [&](Eigen::Index t) {
-          for (int b = 0; b < 10; ++b) {
-            if (!H.is_fixed(T_(t, b))) strides_[10 * t + b] = H.column_stride(T_(t, b));
-            for (int a = 0; a < 10; ++a) offsets_[100 * t + 10 * b + a] = H.block_offset(T_(t, a), T_(t, b));
-          }
-        })) {
-      scatter_for_ = 0;
-      std::rethrow_exception(failed);
-    }
-    scatter_for_ = H.id();
-  }
+  if (!scatter_.built_for(H)) scatter_.build(H, T_);
   // In chunks, so the element matrices in flight stay a few megabytes.
   const Eigen::Index chunk = 1024;
   std::vector<Mat30> K(static_cast<size_t>(std::min(chunk, nt)));
-  double* values = H.values();
   for (Eigen::Index t0 = 0; t0 < nt; t0 += chunk) {
     const Eigen::Index n = std::min(chunk, nt - t0);
 #pragma omp parallel for schedule(static)
     for (Eigen::Index i = 0; i < n; ++i) K[i] = element_hessian(x, t0 + i, project_psd);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Index t = t0 + i;
-      for (int b = 0; b < 10; ++b) {
-        const long stride = strides_[10 * t + b];
-        for (int a = 0; a < 10; ++a) {
-          const long off = offsets_[100 * t + 10 * b + a];
-          if (off < 0) continue;
-          double* v = values + off;
-          for (int k = 0; k < 3; ++k)
-            for (int r = 0; r < 3; ++r) v[k * stride + r] += K[i](3 * a + r, 3 * b + k);
-        }
-      }
-    }
+    for (Eigen::Index i = 0; i < n; ++i) scatter_.add(H, t0 + i, K[i]);
   }
 }
 

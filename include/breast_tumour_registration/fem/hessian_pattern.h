@@ -58,20 +58,28 @@ class HessianAssembler {
   Eigen::SparseMatrix<double> H_;
 };
 
-/// Where every tetrahedron's 4 x 4 vertex blocks sit in one assembler's values, so that element
-/// terms scatter their 12 x 12 matrices without a pattern look-up per block. Built once per
-/// assembler (HessianAssembler::id()); ElasticEnergy and NodalVolumeEnergy keep one each.
-class TetScatter {
+/// Where every element's N x N vertex blocks sit in one assembler's values, so that element
+/// terms scatter their 3N x 3N matrices without a pattern look-up per block. Built once per
+/// assembler (HessianAssembler::id()); ElasticEnergy and NodalVolumeEnergy keep one for their
+/// tetrahedra (N = 4), QuadraticElasticEnergy one for its 10-node elements.
+template <int N>
+class ElementScatter {
  public:
+  using Elements = Eigen::Matrix<int, Eigen::Dynamic, N, Eigen::RowMajor>;
+  using ElementMatrix = Eigen::Matrix<double, 3 * N, 3 * N>;
   bool built_for(const HessianAssembler& H) const { return id_ == H.id(); }
-  void build(const HessianAssembler& H, const Tetrahedra& T);
-  /// Adds K (12 x 12, vertex blocks in T.row(t) order) to H; blocks of fixed vertices are dropped.
-  void add(HessianAssembler& H, Eigen::Index t, const Mat12& K) const;
+  /// Throws std::logic_error (block_offset) for a pair outside the pattern.
+  void build(const HessianAssembler& H, const Elements& T);
+  /// Adds K (vertex blocks in T.row(t) order) to H; blocks of fixed vertices are dropped.
+  void add(HessianAssembler& H, Eigen::Index t, const ElementMatrix& K) const;
 
  private:
   unsigned long id_ = 0;
-  std::vector<long> offsets_;  // 16 per tet, -1 where a vertex is fixed
-  std::vector<long> strides_;  // 4 per tet
+  std::vector<long> offsets_;  // N * N per element, -1 where a vertex is fixed
+  std::vector<long> strides_;  // N per element
 };
+using TetScatter = ElementScatter<4>;
+extern template class ElementScatter<4>;
+extern template class ElementScatter<10>;
 
 }  // namespace btr

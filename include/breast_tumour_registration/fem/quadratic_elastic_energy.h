@@ -72,9 +72,7 @@ class QuadraticElasticEnergy : public EnergyTerm {
   std::vector<StableNeoHookean> local_;  ///< ElementMean: per material, its shear part with lambda_L = 0
   std::vector<double> lambda_lame_;      ///< ElementMean: per material, lambda_L on the mean
   std::vector<Eigen::Matrix<double, 10, 4>> shape_derivatives_;  ///< per quadrature point
-  mutable unsigned long scatter_for_ = 0;
-  mutable std::vector<long> offsets_;  ///< 100 per element, -1 where a node is fixed
-  mutable std::vector<long> strides_;  ///< 10 per element
+  mutable ElementScatter<10> scatter_;  ///< built on first use per assembler
 };
 
 }  // namespace btr
