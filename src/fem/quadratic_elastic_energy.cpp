@@ -8,6 +8,7 @@
 #include "breast_tumour_registration/fem/determinant_eigensystem.h"
 #include "breast_tumour_registration/fem/material_assignment.h"
 #include "breast_tumour_registration/fem/small_matrices.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 
 namespace btr {
 
@@ -28,15 +29,14 @@ QuadraticElasticEnergy::QuadraticElasticEnergy(const QuadraticTetMesh& mesh, con
     throw InputError("QuadraticElasticEnergy: " + std::to_string(rest_corners.rows()) + " rest positions for " +
                      std::to_string(mesh.corners) + " vertices");
   for (const auto& q : rule_) shape_derivatives_.push_back(quadratic_shape_barycentric_derivatives(q.barycentric));
+  // The rest elements are straight-sided: the corner tetrahedra's rest data (InputError on a
+  // degenerate or inverted one) give the volumes and the barycentric gradients.
+  const std::vector<TetRestData> rest = compute_rest_data(TetMesh{rest_corners, T_.leftCols<4>()});
   barycentric_gradients_.resize(T_.rows());
   volume_.resize(T_.rows());
   for (Eigen::Index t = 0; t < T_.rows(); ++t) {
-    Mat3 Dm;
-    for (int k = 0; k < 3; ++k) Dm.col(k) = (rest_corners.row(T_(t, k + 1)) - rest_corners.row(T_(t, 0))).transpose();
-    const double det = Dm.determinant();
-    if (!(det > 0)) throw InputError("QuadraticElasticEnergy: rest tetrahedron " + std::to_string(t) + " is degenerate or inverted");
-    volume_[t] = det / 6;
-    const Mat3 Dinv = Dm.inverse();  // rows: gradients of barycentric coordinates 1..3
+    volume_[t] = rest[t].volume;
+    const Mat3& Dinv = rest[t].Dm_inv;  // rows: gradients of barycentric coordinates 1..3
     barycentric_gradients_[t].row(0) = -Dinv.colwise().sum();
     barycentric_gradients_[t].bottomRows<3>() = Dinv;
   }

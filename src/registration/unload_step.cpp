@@ -57,7 +57,8 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
     throw InputError("prone_gravity: must be a finite, non-zero vector [m/s^2]");
   const TetMesh loaded{model.prone, model.rest.T};
   UnloadProblem pb = unload_problem(model, loaded, prone_gravity);
-  if (cache) pb.solver = &cache->gravity(model);
+  // Quadratic elements build their own solver (another pattern): the linear one is not asked for.
+  if (cache && model.material.unload_element_order == ElementOrder::Linear) pb.solver = &cache->gravity(model);
   const UnloadResult u = estimate_unloaded_shape(pb, with_model_elements(options, model));
 
   StepReport rep = unload_report(u, model.prone);
