@@ -40,12 +40,7 @@ struct Model {
 static Points tumour_positions(const RegistrationModel& rm, const EmbeddedTumour& t, const ForwardGravity& phi,
                                const Points& x) {
   if (phi.quadratic_nodes().rows() == 0) return apply_embedding(t.embedding, rm.rest.T, x);
-  Points p(t.prone.V.rows(), 3);
-  for (Eigen::Index i = 0; i < p.rows(); ++i)
-    p.row(i) = quadratic_interpolate(phi.quadratic_mesh(), phi.quadratic_nodes(), t.embedding.tet[i],
-                                     t.embedding.weights.row(i).transpose())
-                   .transpose();
-  return p;
+  return apply_quadratic_embedding(t.embedding, phi.quadratic_mesh(), phi.quadratic_nodes());
 }
 
 static double worst_error(const RegistrationModel& rm, const ForwardGravity& phi, const Points& x,

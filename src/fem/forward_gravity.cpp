@@ -64,8 +64,10 @@ NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Po
   if (nopt.force_scale <= 0) nopt.force_scale = g->total_weight();
   for (Eigen::Index v = 0; v < X.rows(); ++v)
     if (fixed_[static_cast<size_t>(v)]) x.row(v) = X.row(v);
-  const NewtonResult nr = solver_->solve(energy, x, nopt);
+  NewtonResult nr = solver_->solve(energy, x, nopt);
   newton_iterations_ += nr.iterations;
+  nr.history.clear();
+  last_ = nr;
   return nr;
 }
 
@@ -77,11 +79,11 @@ NewtonResult ForwardGravity::solve_once_quadratic(const Points& X, const Vec3& g
   auto g = std::make_shared<GravityEnergy>(elastic->consistent_masses(density_), gravity);
   energy.add(elastic);
   energy.add(g);
-  if (!solver_) {  // the pattern couples each element's 10 nodes; inversions are checked on its 8 sub-tetrahedra
+  if (!solver_) {  // the pattern couples each element's 10 nodes; inversions are its Jacobian's (inversion_check.h)
     own_ = std::make_unique<NewtonSolver>(
         std::make_shared<HessianAssembler>(static_cast<int>(quadratic_.nodes()), rest_.T, quadratic_fixed_,
                                            energy.hessian_cliques()),
-        quadratic_sub_tetrahedra(quadratic_));
+        InversionCheck::quadratic(quadratic_, opt_.quadrature_degree));
     solver_ = own_.get();
   }
   const Points X2 = straight_sided_positions(quadratic_, X);
@@ -91,8 +93,10 @@ NewtonResult ForwardGravity::solve_once_quadratic(const Points& X, const Vec3& g
     if (quadratic_fixed_[static_cast<size_t>(v)]) x2.row(v) = X2.row(v);
   NewtonOptions nopt = opt_.newton;
   if (nopt.force_scale <= 0) nopt.force_scale = g->total_weight();
-  const NewtonResult nr = solver_->solve(energy, x2, nopt);
+  NewtonResult nr = solver_->solve(energy, x2, nopt);
   newton_iterations_ += nr.iterations;
+  nr.history.clear();
+  last_ = nr;
   x = x2.topRows(nc);
   if (nr.converged) {
     bulge_ = x2.bottomRows(bulge_.rows()) - straight_sided_positions(quadratic_, x).bottomRows(bulge_.rows());

@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include "breast_tumour_registration/fem/tet_kinematics.h"
 
 namespace btr {
 
 LineSearchResult backtracking_line_search(const TotalEnergy& energy, const Points& x, const Points& dx, double E0,
-                                          double slope, long inverted0, const Tetrahedra& T,
+                                          double slope, long inverted0, const InversionCheck& inversions,
                                           const LineSearchOptions& opt, Points& x_out) {
   LineSearchResult r;
   double alpha = 1.0;
@@ -16,7 +15,7 @@ LineSearchResult backtracking_line_search(const TotalEnergy& energy, const Point
     x_out = x + alpha * dx;
     const double E = energy.value(x_out);
     if (!std::isfinite(E) || E > E0 + opt.armijo * alpha * std::min(slope, 0.0)) continue;
-    const long inv = T.rows() ? count_inverted(x_out, T) : 0;
+    const long inv = inversions.count(x_out);
     if (opt.forbid_new_inversions && inv > inverted0) {
       r.inversion_limited = true;
       continue;

@@ -41,13 +41,13 @@ LineSearchOptions line_search_options(const NewtonOptions& opt);
 // Takes the step dx (#V by 3) with the line search from x (energy E, n_inv inverted
 // tetrahedra), updating x, E, n_inv, the iteration's alpha / step norm / line-search time and
 // the result's time totals.
-StepOutcome apply_newton_step(const TotalEnergy& energy, const Tetrahedra& tets, const NewtonOptions& opt,
+StepOutcome apply_newton_step(const TotalEnergy& energy, const InversionCheck& inversions, const NewtonOptions& opt,
                               const Eigen::Ref<const Points>& dx, double slope, Points& x, Points& x_trial, double& E,
                               long& n_inv, IterationInfo& info, NewtonResult& res) {
   const double full_step = dx.rowwise().norm().maxCoeff();
   if (full_step <= opt.step_tolerance) return StepOutcome::TooSmall;
   const auto t0 = Clock::now();
-  const LineSearchResult ls = backtracking_line_search(energy, x, dx, E, slope, n_inv, tets, line_search_options(opt), x_trial);
+  const LineSearchResult ls = backtracking_line_search(energy, x, dx, E, slope, n_inv, inversions, line_search_options(opt), x_trial);
   info.t_line_search = since(t0);
   res.t_assembly += info.t_assembly;
   res.t_factorization += info.t_factorization;
@@ -156,11 +156,11 @@ bool recover_from_stall(StepOutcome outcome, bool direction_was_lagged, NewtonOp
   return false;
 }
 
-NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, const Tetrahedra& tets,
+NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, const InversionCheck& inversions,
                              NewtonLinearSolve& linear, Points& x, const NewtonOptions& opt) {
   const auto t_start = Clock::now();
   NewtonResult res;
-  auto inverted = [&](const Points& p) { return tets.rows() ? count_inverted(p, tets) : 0L; };
+  auto inverted = [&](const Points& p) { return inversions.count(p); };
 
   double E = energy.value(x);
   if (!std::isfinite(E)) throw SolverError("energy is not finite at the initial state (NaN or Inf positions?)");
@@ -232,7 +232,7 @@ NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, con
     Eigen::VectorXd dx_full = Eigen::VectorXd::Zero(x.size());
     H.scatter_add(linear.expand(d), 1.0, dx_full);
     const Eigen::Map<const Points> dx(dx_full.data(), x.rows(), 3);
-    const StepOutcome outcome = apply_newton_step(energy, tets, local, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
+    const StepOutcome outcome = apply_newton_step(energy, inversions, local, dx, g.dot(d), x, x_trial, E, n_inv, info, res);
     if (outcome != StepOutcome::Taken) {
       if (exact) {  // retry on the projected Hessian before calling it a stall
         leave_exact();
@@ -257,8 +257,8 @@ NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, con
     info.elapsed = since(t_start);
     if (record_iteration(info, opt, g_tol, res)) break;
     if (guard.armed && opt.abandon_inverted_fraction > 0 &&
-        static_cast<double>(n_inv - guard.inverted) > opt.abandon_inverted_fraction * static_cast<double>(tets.rows())) {
-      guard.restore_if_worse(x, E, n_inv, res, tets.rows(), 0);  // folding: end here, on the guard's state
+        static_cast<double>(n_inv - guard.inverted) > opt.abandon_inverted_fraction * static_cast<double>(inversions.elements())) {
+      guard.restore_if_worse(x, E, n_inv, res, inversions.elements(), 0);  // folding: end here, on the guard's state
       g = linear.reduce(H.gather(energy.gradient(x)));
       break;
     }
@@ -282,7 +282,7 @@ NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, con
       fresh_factor = true;
     }
   }
-  if (guard.restore_if_worse(x, E, n_inv, res, tets.rows(), opt.max_inverted_fraction_after_stall))
+  if (guard.restore_if_worse(x, E, n_inv, res, inversions.elements(), opt.max_inverted_fraction_after_stall))
     g = linear.reduce(H.gather(energy.gradient(x)));
   res.energy = E;
   res.gradient_norm = g.norm();
@@ -372,15 +372,15 @@ struct NewtonSolver::Impl {
   SparseCholeskySolve linear;
 };
 
-NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets)
-    : assembler_(std::move(assembler)), tets_(std::move(tets)), impl_(std::make_unique<Impl>()) {}
+NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, InversionCheck inversions)
+    : assembler_(std::move(assembler)), inversions_(std::move(inversions)), impl_(std::make_unique<Impl>()) {}
 
 NewtonSolver::~NewtonSolver() = default;
 
 void NewtonSolver::forget_factor() { impl_->linear.forget_factor(); }
 
 NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
-  return newton_minimize(energy, *assembler_, tets_, impl_->linear, x, opt);
+  return newton_minimize(energy, *assembler_, inversions_, impl_->linear, x, opt);
 }
 
 }  // namespace btr

@@ -42,28 +42,6 @@ Points straight_sided_positions(const QuadraticTetMesh& q, const Points& corners
   return x;
 }
 
-Tetrahedra quadratic_sub_tetrahedra(const QuadraticTetMesh& q) {
-  // Local sub-tetrahedra, oriented on the reference element.
-  static const std::array<std::array<int, 4>, 8> local = [] {
-    std::array<std::array<int, 4>, 8> s = {{{{0, 4, 6, 7}}, {{4, 1, 5, 8}}, {{6, 5, 2, 9}}, {{7, 8, 9, 3}},
-                                            {{6, 8, 4, 5}}, {{6, 8, 5, 9}}, {{6, 8, 9, 7}}, {{6, 8, 7, 4}}}};
-    std::array<Vec3, 10> r;
-    r[0] = Vec3(0, 0, 0), r[1] = Vec3(1, 0, 0), r[2] = Vec3(0, 1, 0), r[3] = Vec3(0, 0, 1);
-    for (int e = 0; e < 6; ++e) r[4 + e] = 0.5 * (r[kQuadraticTetEdges[e][0]] + r[kQuadraticTetEdges[e][1]]);
-    for (auto& t : s) {
-      Mat3 D;
-      for (int k = 0; k < 3; ++k) D.col(k) = r[t[k + 1]] - r[t[0]];
-      if (D.determinant() < 0) std::swap(t[2], t[3]);
-    }
-    return s;
-  }();
-  Tetrahedra S(8 * q.T.rows(), 4);
-  for (Eigen::Index t = 0; t < q.T.rows(); ++t)
-    for (int k = 0; k < 8; ++k)
-      for (int a = 0; a < 4; ++a) S(8 * t + k, a) = q.T(t, local[k][a]);
-  return S;
-}
-
 Eigen::Matrix<double, 10, 1> quadratic_shape(const Vec4& b) {
   Eigen::Matrix<double, 10, 1> N;
   for (int i = 0; i < 4; ++i) N[i] = b[i] * (2 * b[i] - 1);
@@ -86,6 +64,20 @@ Vec3 quadratic_interpolate(const QuadraticTetMesh& q, const Points& x, Eigen::In
   const Eigen::Matrix<double, 10, 1> N = quadratic_shape(b);
   Vec3 p = Vec3::Zero();
   for (int a = 0; a < 10; ++a) p += N[a] * x.row(q.T(t, a)).transpose();
+  return p;
+}
+
+Points apply_quadratic_embedding(const Embedding& e, const QuadraticTetMesh& q, const Points& x) {
+  if (x.rows() != q.nodes())
+    throw InputError("quadratic embedding: " + std::to_string(x.rows()) + " positions for " + std::to_string(q.nodes()) +
+                     " nodes");
+  Points p(e.tet.size(), 3);
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    if (e.tet[i] < 0 || e.tet[i] >= q.T.rows())
+      throw InputError("quadratic embedding: point " + std::to_string(i) + " in element " + std::to_string(e.tet[i]) +
+                       " of " + std::to_string(q.T.rows()));
+    p.row(i) = quadratic_interpolate(q, x, e.tet[i], e.weights.row(i).transpose()).transpose();
+  }
   return p;
 }
 

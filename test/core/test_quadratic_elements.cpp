@@ -8,8 +8,10 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/elastic_energy.h"
 #include "breast_tumour_registration/fem/forward_gravity.h"
+#include "breast_tumour_registration/fem/inversion_check.h"
 #include "breast_tumour_registration/fem/quadratic_elastic_energy.h"
 #include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
+#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/fem/unloaded_shape.h"
 #include "breast_tumour_registration/geometry/box_mesh.h"
 #include "energy_checks.h"
@@ -77,18 +79,55 @@ TEST(QuadraticTetrahedra, ShapeFunctionsInterpolateQuadraticFieldsExactly) {
     EXPECT_NEAR(quadratic_shape(b).sum(), 1.0, 1e-14);
     EXPECT_LT((quadratic_interpolate(q, x, t, b) - field(quadratic_interpolate(q, X, t, b))).norm(), 1e-14);
   }
-  // The sub-tetrahedra fill each element, positively oriented.
-  const Tetrahedra S = quadratic_sub_tetrahedra(q);
-  ASSERT_EQ(S.rows(), 8 * q.T.rows());
-  double sub = 0;
-  for (Eigen::Index s = 0; s < S.rows(); ++s) {
-    Mat3 D;
-    for (int k = 0; k < 3; ++k) D.col(k) = (X.row(S(s, k + 1)) - X.row(S(s, 0))).transpose();
-    EXPECT_GT(D.determinant(), 0);
-    sub += D.determinant() / 6;
+  // Points embedded in the linear mesh are carried by the same field (how the phantom's
+  // quadratic truth carries its tumours); a linear embedding carries them only affinely.
+  Points P(20, 3);
+  for (Eigen::Index i = 0; i < P.rows(); ++i) P.row(i) = Vec3(0.04 * u(rng), 0.03 * u(rng), 0.02 * u(rng)).transpose();
+  const Embedding e = embed_points(m, P, OutsidePolicy::Error);
+  const Points carried = apply_quadratic_embedding(e, q, x);
+  Points x_corners(m.V.rows(), 3);
+  for (Eigen::Index v = 0; v < m.V.rows(); ++v) x_corners.row(v) = field(m.V.row(v).transpose()).transpose();
+  const Points affine = apply_embedding(e, m.T, x_corners);
+  double affine_error = 0;
+  for (Eigen::Index i = 0; i < P.rows(); ++i) {
+    EXPECT_LT((carried.row(i).transpose() - field(P.row(i).transpose())).norm(), 1e-14) << i;
+    affine_error = std::max(affine_error, (affine.row(i).transpose() - field(P.row(i).transpose())).norm());
   }
-  EXPECT_NEAR(sub, 0.04 * 0.03 * 0.02, 1e-15);
-  EXPECT_EQ(count_inverted(X, S), 0);
+  EXPECT_GT(affine_error, 1e-5);
+  btr::test::expect_throw_with<InputError>([&] { apply_quadratic_embedding(e, q, x_corners); }, "positions for");
+}
+
+TEST(QuadraticTetrahedra, TheInversionCheckReadsTheJacobianAtQuadraturePointsAndNodes) {
+  // One reference element; its edge node 4 (edge 0-1) lifted by h along z: x = X + N4 (0, 0, h),
+  // N4 = 4 b0 b1, so det J = 1 - 4 h b1, smallest at corner 1: 1 - 4h. Inverted from h = 1/4.
+  Tetrahedra T(1, 4);
+  T << 0, 1, 2, 3;
+  Points V(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  const QuadraticTetMesh q = make_quadratic_tets(T, 4);
+  const Points X = straight_sided_positions(q, V);
+  const int node4 = q.T(0, 4);
+  for (int degree : {2, 5}) {
+    const InversionCheck check = InversionCheck::quadratic(q, degree);
+    EXPECT_EQ(check.elements(), 1);
+    EXPECT_EQ(check.count(X), 0);
+    for (double h : {0.1, 0.24, 0.26, 0.5}) {
+      Points x = X;
+      x(node4, 2) += h;
+      EXPECT_EQ(check.count(x), h < 0.25 ? 0 : 1) << "h " << h << ", degree " << degree;
+    }
+    Points mirrored = X;  // a straight element turned inside out
+    mirrored.col(2) *= -1;
+    EXPECT_EQ(check.count(mirrored), 1);
+  }
+  // Linear tetrahedra convert to a check that is count_inverted.
+  const InversionCheck linear(T);
+  EXPECT_EQ(linear.count(V), 0);
+  Points flat = V;
+  flat.row(3) = Vec3(0.2, 0.2, -0.1).transpose();
+  EXPECT_EQ(linear.count(flat), count_inverted(flat, T));
+  EXPECT_EQ(linear.count(flat), 1);
+  EXPECT_TRUE(InversionCheck().empty());
 }
 
 TEST(QuadraticElasticEnergy, GradientAndHessianMatchFiniteDifferences) {

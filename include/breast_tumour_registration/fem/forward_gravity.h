@@ -67,6 +67,8 @@ class ForwardGravity {
 
   bool is_fixed(Eigen::Index v) const { return fixed_[static_cast<size_t>(v)]; }
   int newton_iterations() const { return newton_iterations_; }  ///< over all solves
+  /// The last Newton solve's result (of the last load fraction, when continued): its stop reason.
+  const NewtonResult& last_newton() const { return last_; }
   int load_steps() const { return load_steps_; }                ///< continuation fractions solved, over all solves
   /// Every continuation step tried, in order, over all solves: (load fraction, converged).
   const std::vector<std::pair<double, bool>>& continuation_steps() const { return continuation_steps_; }
@@ -90,6 +92,7 @@ class ForwardGravity {
   std::unique_ptr<NewtonSolver> own_;
   NewtonSolver* solver_ = nullptr;  ///< own_, or the shared one
   int newton_iterations_ = 0, load_steps_ = 0;
+  NewtonResult last_;
   std::vector<std::pair<double, bool>> continuation_steps_;
   QuadraticTetMesh quadratic_;
   std::vector<bool> quadratic_fixed_;

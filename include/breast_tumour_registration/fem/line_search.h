@@ -3,6 +3,7 @@
 // inverted tetrahedra than the current one.
 #pragma once
 
+#include "breast_tumour_registration/fem/inversion_check.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 
 namespace btr {
@@ -25,9 +26,9 @@ struct LineSearchResult {
 
 /// Tries x + alpha dx for alpha = 1, 1/2, ...; on acceptance x_out holds the new state.
 /// E0, slope (= g . dx, negative for descent) and inverted0 describe the current state x;
-/// T (may be empty) is used to count inverted tetrahedra.
+/// `inversions` counts the inverted elements (an empty check: none).
 LineSearchResult backtracking_line_search(const TotalEnergy& energy, const Points& x, const Points& dx, double E0,
-                                          double slope, long inverted0, const Tetrahedra& T,
+                                          double slope, long inverted0, const InversionCheck& inversions,
                                           const LineSearchOptions& opt, Points& x_out);
 
 }  // namespace btr

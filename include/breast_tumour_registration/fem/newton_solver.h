@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "breast_tumour_registration/fem/inversion_check.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 
@@ -158,15 +159,16 @@ class NewtonLinearSolve {
 /// max(|g0|, force_scale), in the solve's coordinates), or a fresh full Newton step fell below
 /// step_tolerance; a damped step below it is a stall, never convergence. Throws SolverError if
 /// the energy is not finite at the start or the Hessian cannot be factorized.
-NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, const Tetrahedra& tets,
+NewtonResult newton_minimize(const TotalEnergy& energy, HessianAssembler& H, const InversionCheck& inversions,
                              NewtonLinearSolve& linear, Points& x, const NewtonOptions& opt);
 
 /// Newton solver bound to one sparsity pattern: the CHOLMOD symbolic analysis is done on
 /// the first solve and reused by every later solve with the same assembler.
 class NewtonSolver {
  public:
-  /// tets are used only to count inversions for the line search (may be empty).
-  NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Tetrahedra tets);
+  /// `inversions` counts inverted elements for the line search and the fold allowances (linear
+  /// tetrahedra convert to it; may be empty).
+  NewtonSolver(std::shared_ptr<HessianAssembler> assembler, InversionCheck inversions);
   ~NewtonSolver();
   NewtonSolver(const NewtonSolver&) = delete;
   NewtonSolver& operator=(const NewtonSolver&) = delete;
@@ -183,7 +185,7 @@ class NewtonSolver {
  private:
   struct Impl;
   std::shared_ptr<HessianAssembler> assembler_;
-  Tetrahedra tets_;
+  InversionCheck inversions_;
   std::unique_ptr<Impl> impl_;
 };
 

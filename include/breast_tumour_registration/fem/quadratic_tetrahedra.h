@@ -18,6 +18,7 @@
 
 #include "breast_tumour_registration/base/types.h"
 #include "breast_tumour_registration/fem/element_order.h"
+#include "breast_tumour_registration/geometry/embedding.h"
 
 namespace btr {
 
@@ -42,10 +43,6 @@ QuadraticTetMesh make_quadratic_tets(const Tetrahedra& T, Eigen::Index vertices)
 /// All node positions from the corner positions: each edge node at its edge's midpoint.
 Points straight_sided_positions(const QuadraticTetMesh& q, const Points& corners);
 
-/// The 8 linear tetrahedra the corner and edge nodes split each element into (4 at the corners,
-/// 4 in the inner octahedron, split along its (0,2)-(1,3) diagonal): where a deformed quadratic
-/// element folds, one of them inverts. Oriented as the element.
-Tetrahedra quadratic_sub_tetrahedra(const QuadraticTetMesh& q);
 
 /// The 10 shape functions at barycentric coordinates b (b sums to 1).
 Eigen::Matrix<double, 10, 1> quadratic_shape(const Vec4& b);
@@ -54,6 +51,10 @@ Eigen::Matrix<double, 10, 4> quadratic_shape_barycentric_derivatives(const Vec4&
 
 /// The position of the point with barycentric coordinates b in element t at node positions x.
 Vec3 quadratic_interpolate(const QuadraticTetMesh& q, const Points& x, Eigen::Index t, const Vec4& b);
+/// Points embedded in the linear mesh (their element and barycentric coordinates in the
+/// straight-sided rest shape) carried by the quadratic field at node positions x: what
+/// apply_embedding is for linear elements.
+Points apply_quadratic_embedding(const Embedding& e, const QuadraticTetMesh& q, const Points& x);
 
 struct TetQuadraturePoint {
   Vec4 barycentric;
