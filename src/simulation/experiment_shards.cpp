@@ -43,6 +43,7 @@ std::string plan_fingerprint(const ExperimentSuiteOptions& opt, const std::vecto
     << to_string(opt.method_volume_form) << '|' << opt.method_nodal_element_share << '|' << opt.method_nodal_fallback << '|'
     << opt.method_stiffness_budget << '|'
     << (opt.method_unload_element_order == ElementOrder::Quadratic ? "quadratic unload|" : "")
+    << (opt.truth_element_order == ElementOrder::Quadratic ? "quadratic truth|" : "")
     << (opt.given_configurations ? "given" : "generated") << '|';
   for (double e : opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli) s << e << ',';
   for (const auto& r : model.method_regions) s << '|' << r.name << ':' << r.label << ':' << r.relative_stiffness;

@@ -249,6 +249,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
   const std::vector<double>& moduli = opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli() : opt.generating_youngs_moduli;
   RegistrationOptions preset = preset_options(opt.preset);
   preset.stiffness.candidate_budget_factor = opt.method_stiffness_budget;
+  if (opt.given_configurations && opt.truth_element_order != ElementOrder::Linear)
+    throw InputError("the truth's element order applies to the suite's own truth, not to given configurations");
   if (opt.given_configurations)
     for (double e : moduli)
       if (!opt.given_configurations->count(e))
@@ -263,6 +265,7 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
     gen.youngs_modulus = e;
     gen.poisson_ratio = opt.poisson_ratio;
     gen.density = opt.density;
+    gen.element_order = opt.truth_element_order;
     const auto t0 = std::chrono::steady_clock::now();
     PhantomConfigurations conf;
     std::string generation_failure;

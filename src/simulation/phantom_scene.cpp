@@ -7,7 +7,10 @@
 #include <fstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/forward_gravity.h"
 #include "breast_tumour_registration/fem/gravity_simulation.h"
+#include "breast_tumour_registration/fem/inversion_check.h"
+#include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
@@ -54,7 +57,18 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     }
     for (int l : labels) material_of.push_back(index_of[l]);
   }
-  auto solve = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
+  std::vector<StableNeoHookean> materials{StableNeoHookean(opt.youngs_modulus, opt.poisson_ratio)};
+  for (double E : region_E) materials.push_back(StableNeoHookean(E, opt.poisson_ratio));
+  const VolumeForm form = resolve_volume_form(opt.volume_form, opt.poisson_ratio);
+  auto inverted_error = [&](const std::string& name, long inverted, const std::string& elements) {
+    return SolverError(name + " configuration has " + std::to_string(inverted) + " inverted " + elements +
+                       " under this load (E " + std::to_string(static_cast<int>(opt.youngs_modulus)) + " Pa, " +
+                       (opt.element_order == ElementOrder::Quadratic ? std::string("quadratic elements")
+                                                                     : std::string(to_string(form)) + " volume term") +
+                       "): use a finer mesh, a stiffer material or the element volume term");
+  };
+  // Linear elements: one Newton solve from the rest shape.
+  auto solve_linear = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
     GravityProblem pb;
     pb.rest = &model.rest;
     pb.fixed = model.chest_wall;
@@ -73,22 +87,53 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     // A truth with folded elements is no truth (and no valid prone mesh): the element volume
     // term keeps each tetrahedron from inverting, the nodal one only their patches.
     if (const long inverted = count_inverted(r.x, model.rest.T); inverted > 0)
-      throw SolverError(name + " configuration has " + std::to_string(inverted) + " inverted tetrahedra under this load (E " +
-                        std::to_string(static_cast<int>(opt.youngs_modulus)) + " Pa, " +
-                        to_string(resolve_volume_form(opt.volume_form, opt.poisson_ratio)) +
-                        " volume term): use a finer mesh, a stiffer material or the element volume term");
+      throw inverted_error(name, inverted, "tetrahedra");
     out = r.newton;
     return r.x;
   };
+  // Quadratic elements: the forward solve with load continuation (a soft body's 10-node
+  // elements may need it from the straight-sided start); each configuration its own solver, so
+  // neither starts from the other's edge bulge.
+  auto solve_quadratic = [&](const std::string& name, const Vec3& g, NewtonResult& out, Points& nodes,
+                             QuadraticTetMesh& mesh) {
+    ForwardGravityOptions fo;
+    fo.element_order = ElementOrder::Quadratic;
+    if (progress) fo.newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
+    ForwardGravity forward(model.rest.T, model.rest.V.rows(), model.chest_wall, materials, material_of, form,
+                           opt.nodal_element_share, opt.density, fo);
+    Points x = model.rest.V;
+    const int iterations = forward.solve(model.rest.V, g, x);  // throws SolverError when it does not converge
+    out = forward.last_newton();
+    out.iterations = iterations;  // over the continuation's load fractions
+    mesh = forward.quadratic_mesh();
+    nodes = forward.quadratic_nodes();
+    if (const long inverted = InversionCheck::quadratic(mesh, fo.quadrature_degree).count(nodes); inverted > 0)
+      throw inverted_error(name, inverted, "quadratic elements");
+    return x;
+  };
   PhantomConfigurations c;
   c.labels = labels;
-  c.prone = solve("prone", model.prone_gravity, c.prone_newton);
-  c.supine = solve("supine", model.supine_gravity, c.supine_newton);
+  std::function<Points(const Embedding&, bool)> carry;  // embedded points in the prone (false) or supine (true) truth
+  if (opt.element_order == ElementOrder::Quadratic) {
+    auto q = std::make_shared<QuadraticTetMesh>();
+    auto prone_nodes = std::make_shared<Points>(), supine_nodes = std::make_shared<Points>();
+    c.prone = solve_quadratic("prone", model.prone_gravity, c.prone_newton, *prone_nodes, *q);
+    c.supine = solve_quadratic("supine", model.supine_gravity, c.supine_newton, *supine_nodes, *q);
+    carry = [q, prone_nodes, supine_nodes](const Embedding& e, bool supine) {
+      return apply_quadratic_embedding(e, *q, supine ? *supine_nodes : *prone_nodes);
+    };
+  } else {
+    c.prone = solve_linear("prone", model.prone_gravity, c.prone_newton);
+    c.supine = solve_linear("supine", model.supine_gravity, c.supine_newton);
+    carry = [&](const Embedding& e, bool supine) { return apply_embedding(e, model.rest.T, supine ? c.supine : c.prone); };
+  }
   for (const auto& [name, t] : model.tumours) {
     const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
-    c.tumour_prone[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.prone), t.F};
-    c.tumour_supine[name] = SurfaceMesh{apply_embedding(emb, model.rest.T, c.supine), t.F};
+    c.tumour_prone[name] = SurfaceMesh{carry(emb, false), t.F};
+    c.tumour_supine[name] = SurfaceMesh{carry(emb, true), t.F};
   }
+  if (opt.gland_youngs_modulus > 0 && model.gland.F.rows() > 0)
+    c.gland_prone = SurfaceMesh{carry(embed_points(model.rest, model.gland.V, OutsidePolicy::Error), false), model.gland.F};
   return c;
 }
 
@@ -168,8 +213,7 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   if (!conf.labels.empty()) {
     if (opt.gland_youngs_modulus > 0) {
       write_surface(path("gland_rest.obj"), model.gland, unit);
-      const Embedding emb = embed_points(model.rest, model.gland.V, OutsidePolicy::Error);
-      write_surface(path("gland_prone.obj"), SurfaceMesh{apply_embedding(emb, model.rest.T, prone), model.gland.F}, unit);
+      write_surface(path("gland_prone.obj"), conf.gland_prone, unit);
     }
     YAML::Node regions;
     auto region = [&](const char* name, int label, double E) {
@@ -193,8 +237,9 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   scene["generator"]["youngs_modulus"] = opt.youngs_modulus;
   scene["generator"]["poisson_ratio"] = opt.poisson_ratio;
   const VolumeForm generating_form = resolve_volume_form(opt.volume_form, opt.poisson_ratio);
-  scene["generator"]["volume_form"] = to_string(generating_form);
-  if (generating_form == VolumeForm::Nodal) scene["generator"]["nodal_element_share"] = opt.nodal_element_share;
+  scene["generator"]["element_order"] = to_string(opt.element_order);
+  if (opt.element_order == ElementOrder::Linear) scene["generator"]["volume_form"] = to_string(generating_form);
+  if (opt.element_order == ElementOrder::Linear && generating_form == VolumeForm::Nodal) scene["generator"]["nodal_element_share"] = opt.nodal_element_share;
   scene["generator"]["density"] = opt.density;
   scene["generator"]["tumour_youngs_modulus"] = opt.tumour_youngs_modulus;
   scene["generator"]["gland_youngs_modulus"] = opt.gland_youngs_modulus;

@@ -61,6 +61,12 @@ int main(int argc, char** argv) {
                  "(material.unload_element_order; the registration steps stay linear)")
       ->check(CLI::IsMember({"linear", "quadratic"}))
       ->capture_default_str();
+  std::string truth_elements = "linear";
+  app.add_option("--truth-element-order", truth_elements,
+                 "the elements the suite's own truth is generated with: linear (the method's kind) or quadratic "
+                 "(10-node tetrahedra on the same mesh, nearer the converged answer; not with --truth)")
+      ->check(CLI::IsMember({"linear", "quadratic"}))
+      ->capture_default_str();
   double nodal_element_share = 0;
   app.add_option("--nodal-element-share", nodal_element_share,
                  "with the nodal volume term: the volume stiffness each tetrahedron keeps on its own volume "
@@ -122,6 +128,7 @@ int main(int argc, char** argv) {
     opt.method_volume_form = parse_volume_form(volume_form);
     opt.method_nodal_element_share = nodal_element_share;
     opt.method_unload_element_order = parse_element_order(unload_elements);
+    opt.truth_element_order = parse_element_order(truth_elements);
     opt.method_nodal_fallback = nodal_fallback == "on";
     opt.method_stiffness_budget = stiffness_budget;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};

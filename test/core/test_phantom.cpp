@@ -4,6 +4,7 @@
 #include "breast_tumour_registration/fem/gravity_simulation.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/validation.h"
@@ -109,4 +110,43 @@ TEST(Phantom, ATruthWithFoldedElementsIsRefusedWithItsCause) {
   so.volume_form = VolumeForm::Element;
   const PhantomConfigurations c = simulate_phantom(model, so);
   EXPECT_EQ(count_inverted(c.prone, model.rest.T), 0);
+}
+
+TEST(Phantom, AQuadraticTruthSagsAsTheLinearOneDoesOnlyOnAFinerMesh) {
+  // A truth made with the method's own linear tetrahedra flatters it: on the 12 mm mesh at
+  // nu = 0.49 they lock and the tumours move 5 mm prone to supine at 1000 Pa, 7.3 mm at 6 mm
+  // and 8.1 mm at 4 mm (btr_phantom, 2026-12-06); quadratic elements move them about 8.8 mm on
+  // either mesh. The linear answer converges towards the quadratic one from below.
+  auto middle_displacement = [](const PhantomModel& m, ElementOrder order) {
+    PhantomSceneOptions so;
+    so.youngs_modulus = 1000;
+    so.element_order = order;
+    const PhantomConfigurations c = simulate_phantom(m, so);
+    EXPECT_TRUE(c.prone_newton.converged && c.supine_newton.converged);
+    for (int v : m.chest_wall) {
+      EXPECT_EQ((c.prone.row(v) - m.rest.V.row(v)).norm(), 0.0);
+      EXPECT_EQ((c.supine.row(v) - m.rest.V.row(v)).norm(), 0.0);
+    }
+    return (volume_centroid(c.tumour_supine.at("middle")) - volume_centroid(c.tumour_prone.at("middle"))).norm();
+  };
+  PhantomOptions fine;
+  fine.tet.cell_size = 0.006;
+  const double linear12 = middle_displacement(coarse_phantom(), ElementOrder::Linear);
+  const double linear6 = middle_displacement(make_phantom_model(fine), ElementOrder::Linear);
+  const double quadratic12 = middle_displacement(coarse_phantom(), ElementOrder::Quadratic);
+  std::printf("middle tumour prone -> supine: linear 12 mm %.2f, linear 6 mm %.2f, quadratic 12 mm %.2f mm\n", linear12 * 1e3,
+              linear6 * 1e3, quadratic12 * 1e3);
+  EXPECT_LT(linear12, linear6);
+  EXPECT_LT(linear6, quadratic12);
+  EXPECT_GT(quadratic12, 1.5 * linear12);
+
+  // A heterogeneous quadratic truth carries the gland too, and a soft one that the old
+  // sub-tetrahedron check refused (400 Pa: 124 of them inverted, no Jacobian) is a truth.
+  PhantomSceneOptions so;
+  so.youngs_modulus = 400;
+  so.gland_youngs_modulus = 800;
+  so.element_order = ElementOrder::Quadratic;
+  const PhantomConfigurations soft = simulate_phantom(coarse_phantom(), so);
+  EXPECT_EQ(soft.gland_prone.V.rows(), coarse_phantom().gland.V.rows());
+  EXPECT_EQ(soft.labels.size(), static_cast<size_t>(coarse_phantom().rest.T.rows()));
 }

@@ -57,6 +57,9 @@ struct ExperimentSuiteOptions {
   VolumeForm method_volume_form = VolumeForm::Auto;
   double method_nodal_element_share = 0;  ///< the method's MaterialParameters::nodal_element_share
   ElementOrder method_unload_element_order = ElementOrder::Linear;  ///< the method's MaterialParameters::unload_element_order
+  /// The generated truth's elements (PhantomSceneOptions::element_order): quadratic for a truth
+  /// the method's linear tetrahedra did not make. Not with given configurations.
+  ElementOrder truth_element_order = ElementOrder::Linear;
   /// The method's Scene::nodal_fallback: a nodal run that ends not converged is run again with
   /// the element form (its status then ends in " (element form: the nodal did not converge)")
   bool method_nodal_fallback = true;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "breast_tumour_registration/base/units.h"
+#include "breast_tumour_registration/fem/element_order.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/simulation/phantom.h"
 
@@ -31,6 +32,12 @@ struct PhantomSceneOptions {
   /// > 0: the fibroglandular region (PhantomModel::gland) gets this Young's modulus (real
   /// glandular tissue is about 2x stiffer than fat); 0: the body's material.
   double gland_youngs_modulus = 0;
+  /// The generating elements. Linear: the method's own kind, so a truth that flatters it (its
+  /// linear tetrahedra sag too little on a coarse mesh, and so does the truth). Quadratic: the
+  /// prone and supine equilibria with 10-node tetrahedra on the same mesh (ForwardGravity; the
+  /// volume form does not apply), the tumours and gland carried by the quadratic field, the
+  /// written meshes the corner vertices; a truth nearer the converged answer.
+  ElementOrder element_order = ElementOrder::Linear;
 };
 
 /// Cell labels of a heterogeneous phantom's tetrahedra (fat everywhere, then gland, then
@@ -53,11 +60,12 @@ struct PhantomConfigurations {
   Points prone, supine;
   NewtonResult prone_newton, supine_newton;
   std::map<std::string, SurfaceMesh> tumour_prone, tumour_supine;
+  SurfaceMesh gland_prone;  ///< the gland region's surface prone, when the model has one
   std::vector<int> labels;  ///< phantom_tissue_labels (empty: homogeneous)
 };
 
-/// Simulates the configurations of `model` with the generating material of `opt` (the
-/// phantom geometry options are not used). Throws InputError for bad parameters or a
+/// Simulates the configurations of `model` with the generating material and elements of `opt`
+/// (the phantom geometry options are not used). Throws InputError for bad parameters or a
 /// tumour outside the mesh, SolverError when a solve does not converge.
 PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomSceneOptions& opt,
                                        const std::function<bool(const std::string&, const IterationInfo&)>& progress = {});
