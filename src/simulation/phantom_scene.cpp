@@ -150,6 +150,13 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   sum.chest_wall_vertices = static_cast<long>(model.chest_wall.size());
   sum.quality = tet_quality(model.rest);
   const PhantomConfigurations conf = simulate_phantom(model, opt, progress);
+  // Quadratic truth: its curved elements are sound, but the straight tetrahedra between their
+  // corners, which prone.vtk and supine.vtk hold, may not be (a mesh no reader accepts).
+  for (const auto& [name, x] : {std::pair<const char*, const Points*>{"prone", &conf.prone}, {"supine", &conf.supine}})
+    if (const long inverted = count_inverted(*x, model.rest.T); inverted > 0)
+      throw SolverError(std::string(name) + " configuration: the quadratic elements hold, but " + std::to_string(inverted) +
+                        " of the straight tetrahedra between their corners, the mesh " + name +
+                        ".vtk would hold, are inverted: use a finer mesh or a stiffer material");
   sum.prone = conf.prone_newton;
   sum.supine = conf.supine_newton;
   const Points& prone = conf.prone;

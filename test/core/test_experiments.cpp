@@ -294,6 +294,9 @@ TEST(ExperimentSuite, RunsOnConfigurationsMadeElsewhere) {
   o.generating_youngs_moduli = {2000};
   test::expect_throw_with<InputError>([&] { run_experiments(m, o, plan_experiments(o), [](const ExperimentRow&) {}); },
                                       "modulus 2000 Pa: the given truth has no configuration for it");
+  o.truth_element_order = ElementOrder::Quadratic;  // an option of the suite's own truth only
+  test::expect_throw_with<InputError>([&] { run_experiments(m, o, plan_experiments(o), [](const ExperimentRow&) {}); },
+                                      "not to given configurations");
 }
 
 TEST(GivenTruthErrors, NameTheFieldAtFault) {
