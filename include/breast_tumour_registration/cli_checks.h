@@ -9,6 +9,7 @@
 #include <string>
 
 #include "breast_tumour_registration/base/strings.h"
+#include "breast_tumour_registration/fem/element_order.h"
 
 namespace btr::cli {
 
@@ -28,6 +29,15 @@ inline CLI::Validator finite_at_least(double lo, bool inclusive, const std::stri
 inline CLI::Validator positive() { return finite_at_least(0.0, false, "a finite number > 0"); }
 /// >= 0 and finite.
 inline CLI::Validator non_negative() { return finite_at_least(0.0, true, "a finite number >= 0"); }
+
+/// An option `name` taking linear or quadratic, parsed into `order` (whose value is the default).
+inline CLI::Option* element_order_option(CLI::App& app, const std::string& name, ElementOrder& order,
+                                         const std::string& help) {
+  return app
+      .add_option_function<std::string>(name, [&order](const std::string& s) { order = parse_element_order(s); }, help)
+      ->check(CLI::IsMember({"linear", "quadratic"}))
+      ->default_str(to_string(order));
+}
 
 /// Parses; help and version exit 0, any command-line mistake prints CLI11's message and
 /// returns 2. Use as `if (int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;`.

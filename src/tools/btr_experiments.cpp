@@ -55,18 +55,15 @@ int main(int argc, char** argv) {
                  "the generated truth keeps its own")
       ->check(CLI::IsMember({"auto", "element", "nodal"}))
       ->capture_default_str();
-  std::string unload_elements = "linear";
-  app.add_option("--unload-element-order", unload_elements,
-                 "the elements of the method's unloaded-shape estimate and stiffness search: linear or quadratic "
-                 "(material.unload_element_order; the registration steps stay linear)")
-      ->check(CLI::IsMember({"linear", "quadratic"}))
-      ->capture_default_str();
-  std::string truth_elements = "linear";
-  app.add_option("--truth-element-order", truth_elements,
-                 "the elements the suite's own truth is generated with: linear (the method's kind) or quadratic "
-                 "(10-node tetrahedra on the same mesh, nearer the converged answer; not with --truth)")
-      ->check(CLI::IsMember({"linear", "quadratic"}))
-      ->capture_default_str();
+  ElementOrder unload_elements = ElementOrder::Linear, truth_elements = ElementOrder::Linear;
+  btr::cli::element_order_option(app, "--unload-element-order", unload_elements,
+                                 "the elements of the method's unloaded-shape estimate: linear or quadratic "
+                                 "(material.unload_element_order; with E estimated the search compares its candidates "
+                                 "with linear elements; the registration steps stay linear)");
+  btr::cli::element_order_option(app, "--truth-element-order", truth_elements,
+                                 "the elements the suite's own truth is generated with: linear (the method's kind) or "
+                                 "quadratic (10-node tetrahedra on the same mesh, nearer the converged answer; not with "
+                                 "--truth)");
   double nodal_element_share = 0;
   app.add_option("--nodal-element-share", nodal_element_share,
                  "with the nodal volume term: the volume stiffness each tetrahedron keeps on its own volume "
@@ -127,8 +124,8 @@ int main(int argc, char** argv) {
     opt.simulation_cell_size = simulation_cell_mm * 1e-3;
     opt.method_volume_form = parse_volume_form(volume_form);
     opt.method_nodal_element_share = nodal_element_share;
-    opt.method_unload_element_order = parse_element_order(unload_elements);
-    opt.truth_element_order = parse_element_order(truth_elements);
+    opt.method_unload_element_order = unload_elements;
+    opt.truth_element_order = truth_elements;
     opt.method_nodal_fallback = nodal_fallback == "on";
     opt.method_stiffness_budget = stiffness_budget;
     if (quick && moduli.empty()) opt.generating_youngs_moduli = {1000, 4000};

@@ -48,12 +48,11 @@ int main(int argc, char** argv) {
                                                     "scene their regions")
       ->capture_default_str()
       ->check(btr::cli::non_negative());
-  std::string element_order = "linear";
-  app.add_option("--element-order", element_order,
-                 "the generating elements: linear (the registration's own kind) or quadratic (10-node tetrahedra on "
-                 "the same mesh, a truth nearer the converged answer; --volume-form does not apply)")
-      ->check(CLI::IsMember({"linear", "quadratic"}))
-      ->capture_default_str();
+  ElementOrder element_order = ElementOrder::Linear;
+  btr::cli::element_order_option(app, "--element-order", element_order,
+                                 "the generating elements: linear (the registration's own kind) or quadratic (10-node "
+                                 "tetrahedra on the same mesh, a truth nearer the converged answer; --volume-form does "
+                                 "not apply)");
   std::string volume_form = "auto";
   app.add_option("--volume-form", volume_form, "volume term of the generating material: auto, element or nodal "
                                                "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
@@ -90,7 +89,7 @@ int main(int argc, char** argv) {
     o.youngs_modulus = E;
     o.poisson_ratio = nu;
     o.volume_form = parse_volume_form(volume_form);
-    o.element_order = parse_element_order(element_order);
+    o.element_order = element_order;
     o.nodal_element_share = nodal_element_share;
     o.density = rho;
     o.phantom.tet.cell_size = cell_mm * 1e-3;
