@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/forward_gravity.h"

@@ -140,8 +140,9 @@ TEST(Phantom, AQuadraticTruthSagsAsTheLinearOneDoesOnlyOnAFinerMesh) {
   EXPECT_LT(linear6, quadratic12);
   EXPECT_GT(quadratic12, 1.5 * linear12);
 
-  // A heterogeneous quadratic truth carries the gland too, and a soft one that the old
-  // sub-tetrahedron check refused (400 Pa: 124 of them inverted, no Jacobian) is a truth.
+  // A heterogeneous quadratic truth carries the gland too, and a soft one is made: of the kind
+  // the old sub-tetrahedron check refused (homogeneous at 400 Pa: 124 inverted sub-tetrahedra,
+  // no non-positive Jacobian; inversion_check.h).
   PhantomSceneOptions so;
   so.youngs_modulus = 400;
   so.gland_youngs_modulus = 800;

@@ -3,12 +3,13 @@
 //
 // Linear tetrahedra: a non-positive signed volume. Quadratic (10-node) tetrahedra: a
 // non-positive Jacobian determinant of the element's map at any of its quadrature points or
-// nodes, the points where its energy and its shape are evaluated. The element's 8 straight
-// sub-tetrahedra (quadratic_sub_tetrahedra) are no such test: a curved element whose Jacobian is
-// positive everywhere still has inverted sub-tetrahedra once an edge bends by a fraction of its
-// length. Measured on the 12 mm phantom hanging prone at 400 Pa: 79 of 2 270 elements had an
-// inverted sub-tetrahedron, none a non-positive Jacobian at a quadrature point or node, and the
-// sub-tetrahedra made the phantom's quadratic truth refuse itself.
+// nodes, the points where its energy and its shape are evaluated. Until 2026-12-06 (fourth
+// session) the check was the element's 8 straight sub-tetrahedra between its corner and edge
+// nodes, which is no such test: a curved element whose Jacobian is positive everywhere still has
+// inverted sub-tetrahedra once an edge bends by a fraction of its length. Measured on the 12 mm
+// phantom hanging prone at 400 Pa: 79 of 2 270 elements had an inverted sub-tetrahedron, none a
+// non-positive Jacobian at a quadrature point or node, and the sub-tetrahedra made the phantom's
+// quadratic truth refuse itself (and held the unload's line searches back).
 #pragma once
 
 #include <vector>
