@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <chrono>
-#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 using namespace btr;
@@ -24,7 +23,7 @@ int main(int argc, char** argv) {
           s += d / 5; if (n == "middle") mid = d;
         }
         std::printf("E %.0f cell %.0f mm (%ld tets) %s: tumours move %.2f mm on average, middle %.2f mm; corner tets inverted prone %ld; %.1f s\n", E, cell,
-                    (long)m.rest.T.rows(), to_string(o), s, mid, count_inverted(c.prone, m.rest.T),
+                    (long)m.rest.T.rows(), to_string(o), s, mid, c.prone_corner_inversions,
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       } catch (const std::exception& e) { std::printf("E %.0f cell %.0f %s: %s\n", E, cell, to_string(o), e.what()); }
       std::fflush(stdout);

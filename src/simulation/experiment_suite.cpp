@@ -10,7 +10,6 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/base/strings.h"
-#include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
@@ -277,11 +276,10 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
       try {
         conf = simulate_phantom(model, gen);
         // The method's prone mesh is the truth's corners unless it is re-meshed from its surface.
-        if (opt.truth_element_order == ElementOrder::Quadratic && opt.simulation_cell_size <= 0)
-          if (const long inverted = count_inverted(conf.prone, model.rest.T); inverted > 0)
-            throw SolverError("the quadratic truth's prone corners invert " + std::to_string(inverted) +
-                              " of the model's tetrahedra, so that mesh cannot be the method's: re-mesh it "
-                              "(--simulation-cell-size)");
+        if (opt.simulation_cell_size <= 0 && conf.prone_corner_inversions > 0)
+          throw SolverError("the quadratic truth's prone corners invert " + std::to_string(conf.prone_corner_inversions) +
+                            " of the model's tetrahedra, so that mesh cannot be the method's: re-mesh it "
+                            "(--simulation-cell-size)");
       } catch (const std::exception& err) {
         generation_failure = std::string("failed: generating the configurations: ") + err.what();
       }

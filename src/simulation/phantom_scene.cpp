@@ -5,12 +5,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/forward_gravity.h"
 #include "breast_tumour_registration/fem/gravity_simulation.h"
-#include "breast_tumour_registration/fem/inversion_check.h"
 #include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/embedding.h"
@@ -64,9 +62,10 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
   auto inverted_error = [&](const std::string& name, long inverted, const std::string& elements) {
     return SolverError(name + " configuration has " + std::to_string(inverted) + " inverted " + elements +
                        " under this load (E " + std::to_string(static_cast<int>(opt.youngs_modulus)) + " Pa, " +
-                       (opt.element_order == ElementOrder::Quadratic ? std::string("quadratic elements")
-                                                                     : std::string(to_string(form)) + " volume term") +
-                       "): use a finer mesh, a stiffer material or the element volume term");
+                       (opt.element_order == ElementOrder::Quadratic
+                            ? std::string("quadratic elements): use a finer mesh or a stiffer material")
+                            : std::string(to_string(form)) +
+                                  " volume term): use a finer mesh, a stiffer material or the element volume term"));
   };
   // Linear elements: one Newton solve from the rest shape.
   auto solve_linear = [&](const std::string& name, const Vec3& g, NewtonResult& out) {
@@ -86,17 +85,17 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
     GravityResult r = solve_gravity(pb, newton);
     if (!r.newton.converged) throw SolverError(name + " solve did not converge: " + to_string(r.newton.reason));
     // A truth with folded elements is no truth (and no valid prone mesh): the element volume
-    // term keeps each tetrahedron from inverting, the nodal one only their patches.
-    if (const long inverted = count_inverted(r.x, model.rest.T); inverted > 0)
-      throw inverted_error(name, inverted, "tetrahedra");
+    // term keeps each tetrahedron from inverting, the nodal one only their patches. The solve
+    // counted them at its end state.
+    if (r.newton.inverted > 0) throw inverted_error(name, r.newton.inverted, "tetrahedra");
     out = r.newton;
     return r.x;
   };
   // Quadratic elements: the forward solve with load continuation (a soft body's 10-node
   // elements may need it from the straight-sided start); each configuration its own solver, so
   // neither starts from the other's edge bulge.
-  auto solve_quadratic = [&](const std::string& name, const Vec3& g, NewtonResult& out, Points& nodes,
-                             QuadraticTetMesh& mesh) {
+  QuadraticTetMesh q;  // quadratic: the elements (the same for both solves)
+  auto solve_quadratic = [&](const std::string& name, const Vec3& g, NewtonResult& out, Points& nodes) {
     ForwardGravityOptions fo;
     fo.element_order = ElementOrder::Quadratic;
     if (progress) fo.newton.callback = [&](const IterationInfo& it) { return progress(name, it); };
@@ -104,30 +103,31 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
                            opt.nodal_element_share, opt.density, fo);
     Points x = model.rest.V;
     const int iterations = forward.solve(model.rest.V, g, x);  // throws SolverError when it does not converge
-    out = forward.last_newton();
+    out = forward.last_newton();  // its inversions counted on every node (inversion_check.h)
     out.iterations = iterations;  // over the continuation's load fractions
-    mesh = forward.quadratic_mesh();
+    if (out.inverted > 0) throw inverted_error(name, out.inverted, "quadratic elements");
     nodes = forward.quadratic_nodes();
-    if (const long inverted = InversionCheck::quadratic(mesh, fo.quadrature_degree).count(nodes); inverted > 0)
-      throw inverted_error(name, inverted, "quadratic elements");
+    q = forward.quadratic_mesh();
     return x;
   };
   PhantomConfigurations c;
   c.labels = labels;
-  std::function<Points(const Embedding&, bool)> carry;  // embedded points in the prone (false) or supine (true) truth
-  if (opt.element_order == ElementOrder::Quadratic) {
-    auto q = std::make_shared<QuadraticTetMesh>();
-    auto prone_nodes = std::make_shared<Points>(), supine_nodes = std::make_shared<Points>();
-    c.prone = solve_quadratic("prone", model.prone_gravity, c.prone_newton, *prone_nodes, *q);
-    c.supine = solve_quadratic("supine", model.supine_gravity, c.supine_newton, *supine_nodes, *q);
-    carry = [q, prone_nodes, supine_nodes](const Embedding& e, bool supine) {
-      return apply_quadratic_embedding(e, *q, supine ? *supine_nodes : *prone_nodes);
-    };
+  const bool quadratic = opt.element_order == ElementOrder::Quadratic;
+  Points prone_nodes, supine_nodes;  // quadratic: every node of each configuration
+  if (quadratic) {
+    c.prone = solve_quadratic("prone", model.prone_gravity, c.prone_newton, prone_nodes);
+    c.supine = solve_quadratic("supine", model.supine_gravity, c.supine_newton, supine_nodes);
+    c.prone_corner_inversions = count_inverted(c.prone, model.rest.T);
+    c.supine_corner_inversions = count_inverted(c.supine, model.rest.T);
   } else {
     c.prone = solve_linear("prone", model.prone_gravity, c.prone_newton);
     c.supine = solve_linear("supine", model.supine_gravity, c.supine_newton);
-    carry = [&](const Embedding& e, bool supine) { return apply_embedding(e, model.rest.T, supine ? c.supine : c.prone); };
   }
+  // Embedded points in the prone (false) or supine (true) truth.
+  auto carry = [&](const Embedding& e, bool supine) {
+    if (quadratic) return apply_quadratic_embedding(e, q, supine ? supine_nodes : prone_nodes);
+    return apply_embedding(e, model.rest.T, supine ? c.supine : c.prone);
+  };
   for (const auto& [name, t] : model.tumours) {
     const Embedding emb = embed_points(model.rest, t.V, OutsidePolicy::Error);
     c.tumour_prone[name] = SurfaceMesh{carry(emb, false), t.F};
@@ -153,8 +153,9 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   const PhantomConfigurations conf = simulate_phantom(model, opt, progress);
   // Quadratic truth: its curved elements are sound, but the straight tetrahedra between their
   // corners, which prone.vtk and supine.vtk hold, may not be (a mesh no reader accepts).
-  for (const auto& [name, x] : {std::pair<const char*, const Points*>{"prone", &conf.prone}, {"supine", &conf.supine}})
-    if (const long inverted = count_inverted(*x, model.rest.T); inverted > 0)
+  for (const auto& [name, inverted] : {std::pair<const char*, long>{"prone", conf.prone_corner_inversions},
+                                       {"supine", conf.supine_corner_inversions}})
+    if (inverted > 0)
       throw SolverError(std::string(name) + " configuration: the quadratic elements hold, but " + std::to_string(inverted) +
                         " of the straight tetrahedra between their corners, the mesh " + name +
                         ".vtk would hold, are inverted: use a finer mesh or a stiffer material");

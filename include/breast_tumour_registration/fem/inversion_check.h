@@ -33,7 +33,6 @@ class InversionCheck {
   long count(const Points& x) const;
   /// Elements checked (the denominator of the fold allowances).
   Eigen::Index elements() const { return linear_.rows() + quadratic_.rows(); }
-  bool empty() const { return elements() == 0; }
 
  private:
   Tetrahedra linear_;

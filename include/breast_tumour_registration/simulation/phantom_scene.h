@@ -61,6 +61,11 @@ struct PhantomConfigurations {
   NewtonResult prone_newton, supine_newton;
   std::map<std::string, SurfaceMesh> tumour_prone, tumour_supine;
   SurfaceMesh gland_prone;  ///< the gland region's surface prone, when the model has one
+  /// Quadratic truth: the straight tetrahedra between the elements' corners that are inverted,
+  /// prone and supine (the mesh prone.vtk and supine.vtk hold, and the method's unless it is
+  /// re-meshed); the curved elements may hold where these do not. 0 for a linear truth (one
+  /// with an inverted tetrahedron is refused).
+  long prone_corner_inversions = 0, supine_corner_inversions = 0;
   std::vector<int> labels;  ///< phantom_tissue_labels (empty: homogeneous)
 };
 
