@@ -13,7 +13,9 @@
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/geometry/self_intersection.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/geometry/validation.h"
 #include "breast_tumour_registration/io/index_io.h"
 #include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/simulation/rest_model_io.h"
@@ -152,15 +154,14 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   sum.quality = tet_quality(model.rest);
   const PhantomConfigurations conf = simulate_phantom(model, opt, progress);
   // Quadratic truth: its curved elements are sound, but the straight tetrahedra between their
-  // corners, which prone.vtk and supine.vtk hold, may not be (a mesh no reader accepts).
-  for (const auto& [name, inverted] : {std::pair<const char*, long>{"prone", conf.prone_corner_inversions},
-                                       {"supine", conf.supine_corner_inversions}})
-    if (inverted > 0)
-      throw SolverError(std::string(name) + " configuration: the quadratic elements hold, but " + std::to_string(inverted) +
-                        " of the straight tetrahedra between their corners, the mesh " + name +
-                        ".vtk would hold, are inverted: use a finer mesh or a stiffer material");
+  // corners may not be (a mesh no reader accepts). Then the prone model is written as its skin
+  // surface, which the method tetrahedralizes at the generator's cell size (as a preset that
+  // simulates on its own mesh would anyway), with the tissue regions as closed surfaces; a
+  // supine mesh that inverts is not written (it is information only). The skin itself must hold.
+  const bool prone_as_surface = conf.prone_corner_inversions > 0;
   sum.prone = conf.prone_newton;
   sum.supine = conf.supine_newton;
+  sum.prone_written_as_surface = prone_as_surface;
   const Points& prone = conf.prone;
   const Points& supine = conf.supine;
 
@@ -169,10 +170,34 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   write_rest_model(dir, model, unit);  // rest.vtk, chest_wall.txt, chest_ring.obj, tumours, model.yaml
   TetMesh m = model.rest;
   m.V = prone;
-  write_tet_mesh(path("prone.vtk"), m, unit, conf.labels);  // the tissue labels a segmentation would give
-  write_surface(path("prone_surface.obj"), boundary_surface(m), unit);
+  std::vector<int> surface_of_tet;  // prone_surface.obj's vertex -> the mesh's
+  const SurfaceMesh prone_surface = boundary_surface(m, &surface_of_tet);
+  if (prone_as_surface) {
+    validate_surface(prone_surface, "prone surface");  // a boundary of a tetrahedral mesh: closed and oriented
+    const long crossings = self_intersecting_face_pairs(prone_surface);
+    if (crossings > 0)
+      throw SolverError("prone configuration: " + std::to_string(conf.prone_corner_inversions) +
+                        " of the straight tetrahedra between the quadratic elements' corners are inverted, and the skin "
+                        "between the corners crosses itself (" + std::to_string(crossings) +
+                        " pairs of faces), so it cannot stand in for them: use a finer mesh or a stiffer material");
+  } else {
+    write_tet_mesh(path("prone.vtk"), m, unit, conf.labels);  // the tissue labels a segmentation would give
+  }
+  write_surface(path("prone_surface.obj"), prone_surface, unit);
+  std::vector<int> surface_index(static_cast<size_t>(m.V.rows()), -1);
+  for (size_t i = 0; i < surface_of_tet.size(); ++i) surface_index[static_cast<size_t>(surface_of_tet[i])] = static_cast<int>(i);
+  auto prone_index = [&](int v) {  // a vertex of the skin, numbered as the scene's prone model numbers it
+    if (!prone_as_surface) return v;
+    if (surface_index[static_cast<size_t>(v)] < 0) throw SolverError("phantom: vertex " + std::to_string(v) + " is not on the skin");
+    return surface_index[static_cast<size_t>(v)];
+  };
+  if (prone_as_surface) {
+    std::vector<int> wall;
+    for (int v : model.chest_wall) wall.push_back(prone_index(v));
+    write_index_list(path("chest_wall_prone_surface.txt"), wall);
+  }
   m.V = supine;
-  write_tet_mesh(path("supine.vtk"), m, unit);
+  if (conf.supine_corner_inversions == 0) write_tet_mesh(path("supine.vtk"), m, unit);
   write_surface(path("supine_surface.obj"), boundary_surface(m), unit);
 
   std::vector<LandmarkPair> pairs;
@@ -180,8 +205,8 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   for (const auto& [name, v] : model.landmarks) lm_vertices[name] = v;
   for (const auto& name : landmark_names) {
     LandmarkPair p;
-    p.prone_vertex = model.landmarks.at(name);
-    p.supine_point = supine.row(p.prone_vertex).transpose();
+    p.prone_vertex = prone_index(model.landmarks.at(name));
+    p.supine_point = supine.row(model.landmarks.at(name)).transpose();
     pairs.push_back(p);
   }
   write_landmark_pairs(path("landmarks.csv"), pairs, unit);
@@ -204,15 +229,20 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   YAML::Node scene;
   scene["units"] = to_string(unit);
   scene["frame"] = "chest wall in z = 0, breast towards +z; prone gravity +z, supine gravity -z";
-  scene["prone"]["tet_mesh"] = "prone.vtk";
-  scene["prone"]["surface"] = "prone_surface.obj";
+  if (prone_as_surface) {
+    scene["prone"]["surface"] = "prone_surface.obj";
+    scene["prone"]["cell_size_mm"] = opt.phantom.tet.cell_size * 1e3;
+  } else {
+    scene["prone"]["tet_mesh"] = "prone.vtk";
+    scene["prone"]["surface"] = "prone_surface.obj";
+  }
   scene["rest"]["tet_mesh"] = "rest.vtk";
   scene["rest"]["surface"] = "rest_surface.obj";
-  scene["chest_wall"] = "chest_wall.txt";
+  scene["chest_wall"] = prone_as_surface ? "chest_wall_prone_surface.txt" : "chest_wall.txt";
   scene["chest_ring"] = "chest_ring.obj";
   scene["supine"]["surface"] = "supine_surface.obj";
   scene["supine"]["chest_ring"] = "chest_ring.obj";
-  scene["supine"]["tet_mesh_ground_truth"] = "supine.vtk";
+  if (conf.supine_corner_inversions == 0) scene["supine"]["tet_mesh_ground_truth"] = "supine.vtk";
   scene["landmarks"] = "landmarks.csv";
   scene["landmark_set"] = opt.landmark_set;
   scene["landmark_vertices"] = lm_vertices;
@@ -224,17 +254,24 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
       write_surface(path("gland_rest.obj"), model.gland, unit);
       write_surface(path("gland_prone.obj"), conf.gland_prone, unit);
     }
+    // By cell label of prone.vtk; a prone model written as its surface has no cells, so there
+    // each region is its closed prone surface (the labels were given by centroid inside them).
     YAML::Node regions;
-    auto region = [&](const char* name, int label, double E) {
+    auto region = [&](const std::string& name, int label, const std::string& surface, double E) {
       if (E <= 0) return;
       YAML::Node r;
       r["name"] = name;
-      r["label"] = label;
+      if (prone_as_surface) r["surface"] = surface;
+      else r["label"] = label;
       r["relative_stiffness"] = E / opt.youngs_modulus;
       regions.push_back(r);
     };
-    region("gland", kPhantomGlandLabel, opt.gland_youngs_modulus);
-    region("tumour", kPhantomTumourLabel, opt.tumour_youngs_modulus);
+    region("gland", kPhantomGlandLabel, "gland_prone.obj", opt.gland_youngs_modulus);
+    if (prone_as_surface)
+      for (const auto& name : phantom_tumour_names())
+        region("tumour_" + name, kPhantomTumourLabel, "tumour_" + name + "_prone.obj", opt.tumour_youngs_modulus);
+    else
+      region("tumour", kPhantomTumourLabel, "", opt.tumour_youngs_modulus);
     scene["regions"] = regions;
   }
   scene["material"]["youngs_modulus"] = 3400.0;

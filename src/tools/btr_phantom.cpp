@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
   btr::cli::element_order_option(app, "--element-order", element_order,
                                  "the generating elements: linear (the registration's own kind) or quadratic (10-node "
                                  "tetrahedra on the same mesh, a truth nearer the converged answer; --volume-form does "
-                                 "not apply)");
+                                 "not apply; where the straight tetrahedra between their corners invert prone, the scene "
+                                 "gives the prone model as its skin surface)");
   std::string volume_form = "auto";
   app.add_option("--volume-form", volume_form, "volume term of the generating material: auto, element or nodal "
                                                "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
@@ -125,7 +126,12 @@ int main(int argc, char** argv) {
                   f.volume.ny, f.volume.nz, lo.voxel_size.x() * 1e3, lo.voxel_size.y() * 1e3, lo.voxel_size.z() * 1e3);
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("\n[phantom] wrote scene to %s (scene.yaml, rest/prone/supine .vtk and surfaces, 15 tumour OBJs, "
+    if (s.prone_written_as_surface)
+      std::printf("\n[phantom] the straight tetrahedra between the quadratic elements' corners invert prone, so the scene gives "
+                  "the prone model as its skin (prone_surface.obj, meshed at %.2f mm by the method; chest wall and landmarks "
+                  "numbered on it, regions as closed surfaces) and no prone.vtk",
+                  cell_mm);
+    std::printf("\n[phantom] wrote scene to %s (scene.yaml, rest/prone/supine meshes and surfaces, 15 tumour OBJs, "
                 "landmarks.csv, chest_wall.txt, chest_ring.obj) in %.1f s\n",
                 fs::absolute(out_dir).string().c_str(), secs);
     return 0;

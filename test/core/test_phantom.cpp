@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <set>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -7,7 +8,9 @@
 #include "breast_tumour_registration/geometry/metrics.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
+#include "breast_tumour_registration/geometry/tetrahedralize.h"
 #include "breast_tumour_registration/geometry/validation.h"
+#include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/simulation/phantom.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "test_util.h"
@@ -150,4 +153,51 @@ TEST(Phantom, AQuadraticTruthSagsAsTheLinearOneDoesOnlyOnAFinerMesh) {
   const PhantomConfigurations soft = simulate_phantom(coarse_phantom(), so);
   EXPECT_EQ(soft.gland_prone.V.rows(), coarse_phantom().gland.V.rows());
   EXPECT_EQ(soft.labels.size(), static_cast<size_t>(coarse_phantom().rest.T.rows()));
+}
+
+TEST(Phantom, AQuadraticTruthWhoseCornersInvertIsWrittenAsItsSkin) {
+  // Soft quadratic truth on a coarse mesh: the curved elements hold, the straight tetrahedra
+  // between their corners do not (a prone.vtk no reader accepts). The scene then gives the prone
+  // model as its skin, tetrahedralized by the method, with the chest wall and landmarks
+  // numbered on that skin and the regions as the closed surfaces the labels were made from.
+  PhantomSceneOptions o;
+  o.phantom.tet.cell_size = 0.012;
+  o.phantom.surface_rings = 12;
+  o.youngs_modulus = 350;
+  o.gland_youngs_modulus = 700;
+  o.tumour_youngs_modulus = 3500;
+  o.element_order = ElementOrder::Quadratic;
+  const std::string d = btr::test::temp_dir();
+  const PhantomSceneSummary sum = write_phantom_scene(d, o);
+  ASSERT_TRUE(sum.prone_written_as_surface);
+  EXPECT_FALSE(std::filesystem::exists(d + "/prone.vtk"));
+  const PhantomConfigurations c = simulate_phantom(make_phantom_model(o.phantom), o);
+  EXPECT_GT(c.prone_corner_inversions, 0);
+
+  const Scene s = load_meshed_scene(d + "/scene.yaml");
+  ASSERT_TRUE(s.prone_source.has_value());
+  EXPECT_GT(s.prone.T.rows(), 500);
+  EXPECT_EQ(count_inverted(s.prone.V, s.prone.T), 0);
+  // The chest wall is the plane z = 0 of the phantom, prone as at rest.
+  ASSERT_GT(s.chest_wall.size(), 10u);
+  for (int v : s.chest_wall) EXPECT_NEAR(s.prone.V(v, 2), 0.0, 1e-9) << v;
+  // Each landmark sits where the truth's skin vertex is and pairs with that vertex supine.
+  const PhantomModel model = make_phantom_model(o.phantom);
+  const auto names = phantom_landmark_set(o.landmark_set);
+  ASSERT_EQ(s.landmark_anchors.size(), names.size());
+  // Prone, within the re-meshed skin's approximation of the written one (tetrahedralize.h).
+  const double skin_tolerance = TetrahedralizeOptions{}.facet_distance_ratio * o.phantom.tet.cell_size;
+  for (size_t i = 0; i < names.size(); ++i) {
+    const int v = model.landmarks.at(names[i]);
+    EXPECT_LT((s.landmark_anchors[i].position(s.prone.V) - c.prone.row(v).transpose()).norm(), skin_tolerance) << names[i];
+    EXPECT_NEAR((s.landmark_supine.row(static_cast<Eigen::Index>(i)) - c.supine.row(v)).norm(), 0.0, 1e-6) << names[i];
+  }
+  // The regions: the gland and each tumour by its prone surface, at the generating ratios.
+  ASSERT_EQ(s.regions.size(), 1u + phantom_tumour_names().size());
+  EXPECT_EQ(s.regions[0].name, "gland");
+  EXPECT_NEAR(s.regions[0].youngs_modulus, 2 * s.material.youngs_modulus, 1e-9);
+  for (size_t k = 1; k < s.regions.size(); ++k) {
+    EXPECT_TRUE(s.regions[k].surface.has_value()) << s.regions[k].name;
+    EXPECT_NEAR(s.regions[k].youngs_modulus, 10 * s.material.youngs_modulus, 1e-9);
+  }
 }

@@ -3,6 +3,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/box_mesh.h"
+#include "breast_tumour_registration/geometry/self_intersection.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/validation.h"
 #include "test_util.h"
@@ -44,6 +45,17 @@ TEST(ValidateSurface, NonManifoldEdgeNaNAndDegenerateFaces) {
   SurfaceMesh deg = s;
   deg.V.row(deg.F(2, 1)) = deg.V.row(deg.F(2, 0));
   expect_throw_with<InputError>([&] { validate_surface(deg, "m"); }, "zero area");
+}
+
+TEST(SelfIntersection, ASkinPushedThroughItselfIsSeenWhereValidationIsBlind) {
+  SurfaceMesh s = make_icosphere(Vec3::Zero(), 0.05, 2);
+  EXPECT_EQ(self_intersecting_face_pairs(s), 0);
+  // One vertex pushed through the far side: the connectivity and orientation are as before.
+  s.V.row(0) *= -1.6;
+  validate_surface(s, "folded sphere");
+  EXPECT_GT(self_intersecting_face_pairs(s), 0);
+  s.F(0, 1) = static_cast<int>(s.V.rows());
+  EXPECT_THROW(self_intersecting_face_pairs(s), InputError);
 }
 
 TEST(ValidateTetMesh, BoxPassesAndBoundaryIsClosed) {

@@ -50,6 +50,10 @@ struct PhantomSceneSummary {
   long vertices = 0, tetrahedra = 0, chest_wall_vertices = 0;
   TetQuality quality;
   NewtonResult prone, supine;
+  /// Quadratic truth whose straight corner tetrahedra invert prone: the scene's prone model is
+  /// prone_surface.obj with prone.cell_size_mm (the method tetrahedralizes it), its chest wall
+  /// and landmarks numbered on that surface and its regions closed surfaces; no prone.vtk.
+  bool prone_written_as_surface = false;
   std::vector<std::pair<std::string, double>> tumour_displacement;  ///< prone -> supine centroid [m]
 };
 
@@ -62,8 +66,8 @@ struct PhantomConfigurations {
   std::map<std::string, SurfaceMesh> tumour_prone, tumour_supine;
   SurfaceMesh gland_prone;  ///< the gland region's surface prone, when the model has one
   /// Quadratic truth: the straight tetrahedra between the elements' corners that are inverted,
-  /// prone and supine (the mesh prone.vtk and supine.vtk hold, and the method's unless it is
-  /// re-meshed); the curved elements may hold where these do not. 0 for a linear truth (one
+  /// prone and supine (the mesh prone.vtk and supine.vtk would hold, and the method's unless it
+  /// is re-meshed); the curved elements may hold where these do not. 0 for a linear truth (one
   /// with an inverted tetrahedron is refused).
   long prone_corner_inversions = 0, supine_corner_inversions = 0;
   std::vector<int> labels;  ///< phantom_tissue_labels (empty: homogeneous)
@@ -76,7 +80,8 @@ PhantomConfigurations simulate_phantom(const PhantomModel& model, const PhantomS
                                        const std::function<bool(const std::string&, const IterationInfo&)>& progress = {});
 
 /// Generates and writes the scene into `dir` (created). `progress` (optional) sees every
-/// Newton iteration of the "prone" and "supine" solves. Throws InputError / SolverError.
+/// Newton iteration of the "prone" and "supine" solves. Throws InputError / SolverError (also
+/// for a quadratic truth whose prone skin, the corners' boundary, intersects itself).
 PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSceneOptions& opt,
                                         const std::function<bool(const std::string&, const IterationInfo&)>& progress = {});
 
