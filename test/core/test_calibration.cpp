@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
@@ -21,8 +22,24 @@ using btr::test::write_text;
 namespace {
 /// A coarse phantom (12 mm cells, 12 surface rings) generated at Young's modulus e, in a fresh
 /// folder named prefix + e; returns the folder.
-std::string coarse_phantom_at(double e, const std::string& prefix) {
-  return btr::test::write_coarse_phantom_in(btr::test::temp_dir() + "/" + prefix + std::to_string(static_cast<int>(e)), e);
+std::string coarse_phantom_at(double e, const std::string& prefix, ElementOrder truth_elements = ElementOrder::Linear) {
+  return btr::test::write_coarse_phantom_in(btr::test::temp_dir() + "/" + prefix + std::to_string(static_cast<int>(e)), e,
+                                            truth_elements);
+}
+
+/// The scene in folder d with `youngs_modulus: estimate` and the prone gravity (the model is
+/// unloaded at the estimate), written as d/name.yaml; `keep_ring` false drops the chest ring.
+Scene estimating_scene(const std::string& d, const std::string& name, bool keep_ring) {
+  std::string text, line;
+  std::istringstream is(scene_text(d));
+  while (std::getline(is, line))
+    if (keep_ring || line.find("chest_ring:") == std::string::npos) text += line + "\n";
+  const std::string told = "material:\n  youngs_modulus: 3400\n";
+  const size_t at = text.find(told);
+  if (at == std::string::npos) throw std::runtime_error(d + ": no 'youngs_modulus: 3400' to replace");
+  text.replace(at, told.size(), "material:\n  youngs_modulus: estimate\n");
+  write_text(d + "/" + name + ".yaml", text + "prone_gravity: [0, 0, 9.81]\n");
+  return load_scene(d + "/" + name + ".yaml");
 }
 
 /// Every row of run_calibration over `scenes`: this preset, `draws` noisy copies of each scene,
@@ -178,6 +195,38 @@ TEST(Calibration, TheSampledRegionHoldsTheTruthOnPhantomsOfUnknownStiffness) {
   EXPECT_GE(s.observed, 0.7);
 }
 
+// The phantom's calibration, re-measured on truth made with quadratic elements (which our
+// linear ones did not make, and which sags farther): at the study's scale (654 to 2533 Pa, E
+// estimated, balanced) the 95 % region held 72 of 75 rows sampled and 75 of 75 linearised,
+// with the errors 9 to 76 % larger than on the linear truth of the same bodies and the radii
+// the same (BENCHMARKS.md, "The tumour's region on a truth our elements did not make"). The
+// quick version: two coarse bodies, E estimated from the noisy landmarks in every copy and
+// sample (measured: 17 of 20 held sampled, 19 of 20 linearised, worst error 2.5 mm; with 8
+// samples a copy the sampled radius was 15 % smaller and held 14 of 20).
+TEST(Calibration, TheRegionsHoldATruthTheMethodsElementsDidNotMake) {
+  std::vector<Scene> scenes;
+  for (double e : {900.0, 1800.0}) scenes.push_back(estimating_scene(coarse_phantom_at(e, "quadratic_E", ElementOrder::Quadratic), "estimated", true));
+  const std::vector<CalibrationRow> rows = calibration_rows(scenes, "fast", 2, 16);
+  ASSERT_EQ(rows.size(), 20u);
+  const Coverage s = observed_coverage(rows, 0.95, true), l = observed_coverage(rows, 0.95, false);
+  std::vector<double> ratio;
+  double error = 0;
+  for (const auto& r : rows) {
+    EXPECT_TRUE(r.converged) << r.scene << " " << r.tumour;
+    EXPECT_GT(r.youngs_modulus_log_sd, 0) << r.scene;
+    ratio.push_back(r.sampled_radius_95 / r.error);
+    error = std::max(error, r.error);
+  }
+  std::sort(ratio.begin(), ratio.end());
+  const double median_ratio = ratio[ratio.size() / 2];
+  std::printf("quadratic-truth quick calibration: sampled 95 %% region held %.2f [%.2f, %.2f], linear %.2f of %d; "
+              "worst error %.2f mm, median sampled radius / error %.2f\n",
+              s.observed, s.low, s.high, l.observed, s.rows, error * 1e3, median_ratio);
+  EXPECT_GE(s.observed, 0.7);
+  EXPECT_GE(l.observed, 0.7);
+  EXPECT_LT(median_ratio, 6.0);
+}
+
 // Without a chest ring the pose is solved with the deformation, and the linear region keeps it
 // free, with the landmarks that share it as a source and the skin free to slide: on two
 // independent bodies and on the calibration study's ring-free phantoms it held 93 to 96 % of
@@ -189,17 +238,7 @@ TEST(Calibration, TheSampledRegionHoldsTheTruthOnPhantomsOfUnknownStiffness) {
 TEST(Calibration, WithoutAChestRingTheLinearRegionHoldsTheTruthAtItsLevel) {
   std::vector<Scene> scenes;
   for (double e : {600.0, 1800.0}) {
-    const std::string d = coarse_phantom_at(e, "ring_free_E");
-    std::string text, line;
-    std::istringstream is(scene_text(d));
-    while (std::getline(is, line))
-      if (line.find("chest_ring:") == std::string::npos) text += line + "\n";
-    const std::string told = "material:\n  youngs_modulus: 3400\n";
-    const size_t at = text.find(told);
-    ASSERT_NE(at, std::string::npos) << text;
-    text.replace(at, told.size(), "material:\n  youngs_modulus: estimate\n");
-    write_text(d + "/ring_free.yaml", text + "prone_gravity: [0, 0, 9.81]\n");
-    scenes.push_back(load_scene(d + "/ring_free.yaml"));
+    scenes.push_back(estimating_scene(coarse_phantom_at(e, "ring_free_E"), "ring_free", false));
     ASSERT_FALSE(scenes.back().prone_rigid);
   }
   const std::vector<CalibrationRow> rows = calibration_rows(scenes, "balanced", 4, 0);

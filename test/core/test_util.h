@@ -29,13 +29,16 @@ inline std::string temp_dir() {
 }
 
 /// A coarse phantom scene (12 mm cells, 12 surface rings, 2.2k tetrahedra) whose truth our FEM
-/// made at `youngs_modulus` [Pa], written afresh into folder `d`; returns d.
-inline std::string write_coarse_phantom_in(const std::string& d, double youngs_modulus) {
+/// made at `youngs_modulus` [Pa] with `truth_elements` (linear: the method's own kind), written
+/// afresh into folder `d`; returns d.
+inline std::string write_coarse_phantom_in(const std::string& d, double youngs_modulus,
+                                           ElementOrder truth_elements = ElementOrder::Linear) {
   std::filesystem::remove_all(d);
   PhantomSceneOptions o;
   o.phantom.tet.cell_size = 0.012;
   o.phantom.surface_rings = 12;
   o.youngs_modulus = youngs_modulus;
+  o.element_order = truth_elements;
   write_phantom_scene(d, o);
   return d;
 }
