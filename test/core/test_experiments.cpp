@@ -116,7 +116,7 @@ TEST(ExperimentSuite, OnATruthItsElementsDidNotMakeTheMethodStillLands) {
   // nu = 0.49 and sag too little, and so did a truth they made), the method re-meshed from the
   // prone boundary: no shared mesh, no shared elements. On the 11 mm phantom at 1000 Pa the
   // full method ends 0.86 mm off (0.91 mm unloaded at an estimated E), rigid alignment 9.3 mm
-  // (2026-12-06); on our own truth and mesh it was 0.06 mm.
+  // (2026-12-06); on the 8 mm phantom's own linear truth and mesh it was 0.07 mm.
   ExperimentSuiteOptions o;
   o.quick = true;
   o.generating_youngs_moduli = {1000};
