@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <set>
+#include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/closest_point.h"
@@ -37,7 +38,7 @@ std::vector<int> boundary_vertices(const TetMesh& mesh) {
   return v;
 }
 
-SurfaceMesh boundary_surface(const TetMesh& mesh, std::vector<int>* to_tet) {
+SurfaceMesh boundary_surface(const TetMesh& mesh, std::vector<int>* to_tet, std::vector<int>* from_tet) {
   const Triangles F = boundary_faces(mesh);
   const std::vector<int> verts = boundary_vertices(mesh);
   std::vector<int> compact(mesh.V.rows(), -1);
@@ -51,6 +52,7 @@ SurfaceMesh boundary_surface(const TetMesh& mesh, std::vector<int>* to_tet) {
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) s.F(f, k) = compact[F(f, k)];
   if (to_tet) *to_tet = verts;
+  if (from_tet) *from_tet = std::move(compact);
   return s;
 }
 

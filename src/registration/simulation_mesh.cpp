@@ -14,10 +14,8 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size) {
   if (!(cell_size > 0) || !std::isfinite(cell_size))
     throw InputError("simulation cell size must be positive, got " + std::to_string(cell_size * 1e3) + " mm");
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<int> to_tet;
-  const SurfaceMesh surface = boundary_surface(scene.prone, &to_tet);
-  std::vector<int> surface_index(scene.prone.V.rows(), -1);
-  for (size_t i = 0; i < to_tet.size(); ++i) surface_index[to_tet[i]] = static_cast<int>(i);
+  std::vector<int> surface_index;
+  const SurfaceMesh surface = boundary_surface(scene.prone, nullptr, &surface_index);
   std::vector<int> wall;
   for (int v : scene.chest_wall)
     if (surface_index[v] >= 0) wall.push_back(surface_index[v]);

@@ -170,8 +170,8 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
   write_rest_model(dir, model, unit);  // rest.vtk, chest_wall.txt, chest_ring.obj, tumours, model.yaml
   TetMesh m = model.rest;
   m.V = prone;
-  std::vector<int> surface_of_tet;  // prone_surface.obj's vertex -> the mesh's
-  const SurfaceMesh prone_surface = boundary_surface(m, &surface_of_tet);
+  std::vector<int> surface_index;  // the mesh's vertex -> prone_surface.obj's (-1 off the skin)
+  const SurfaceMesh prone_surface = boundary_surface(m, nullptr, &surface_index);
   if (prone_as_surface) {
     validate_surface(prone_surface, "prone surface");  // a boundary of a tetrahedral mesh: closed and oriented
     const long crossings = self_intersecting_face_pairs(prone_surface);
@@ -184,8 +184,6 @@ PhantomSceneSummary write_phantom_scene(const std::string& dir, const PhantomSce
     write_tet_mesh(path("prone.vtk"), m, unit, conf.labels);  // the tissue labels a segmentation would give
   }
   write_surface(path("prone_surface.obj"), prone_surface, unit);
-  std::vector<int> surface_index(static_cast<size_t>(m.V.rows()), -1);
-  for (size_t i = 0; i < surface_of_tet.size(); ++i) surface_index[static_cast<size_t>(surface_of_tet[i])] = static_cast<int>(i);
   auto prone_index = [&](int v) {  // a vertex of the skin, numbered as the scene's prone model numbers it
     if (!prone_as_surface) return v;
     if (surface_index[static_cast<size_t>(v)] < 0) throw SolverError("phantom: vertex " + std::to_string(v) + " is not on the skin");

@@ -171,7 +171,8 @@ TEST(Phantom, AQuadraticTruthWhoseCornersInvertIsWrittenAsItsSkin) {
   const PhantomSceneSummary sum = write_phantom_scene(d, o);
   ASSERT_TRUE(sum.prone_written_as_surface);
   EXPECT_FALSE(std::filesystem::exists(d + "/prone.vtk"));
-  const PhantomConfigurations c = simulate_phantom(make_phantom_model(o.phantom), o);
+  const PhantomModel model = make_phantom_model(o.phantom);
+  const PhantomConfigurations c = simulate_phantom(model, o);
   EXPECT_GT(c.prone_corner_inversions, 0);
 
   const Scene s = load_meshed_scene(d + "/scene.yaml");
@@ -182,7 +183,6 @@ TEST(Phantom, AQuadraticTruthWhoseCornersInvertIsWrittenAsItsSkin) {
   ASSERT_GT(s.chest_wall.size(), 10u);
   for (int v : s.chest_wall) EXPECT_NEAR(s.prone.V(v, 2), 0.0, 1e-9) << v;
   // Each landmark sits where the truth's skin vertex is and pairs with that vertex supine.
-  const PhantomModel model = make_phantom_model(o.phantom);
   const auto names = phantom_landmark_set(o.landmark_set);
   ASSERT_EQ(s.landmark_anchors.size(), names.size());
   // Prone, within the re-meshed skin's approximation of the written one (tetrahedralize.h).

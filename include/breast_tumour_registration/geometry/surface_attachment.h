@@ -28,7 +28,8 @@ std::vector<int> boundary_vertices_near_region(const TetMesh& mesh, const Surfac
 std::vector<int> boundary_vertices(const TetMesh& mesh);
 
 /// Closed surface made of the boundary faces of `mesh`, with its own compact vertex
-/// numbering; `to_tet` (optional) receives the tet-mesh index of every surface vertex.
-SurfaceMesh boundary_surface(const TetMesh& mesh, std::vector<int>* to_tet = nullptr);
+/// numbering; `to_tet` (optional) receives the tet-mesh index of every surface vertex, and
+/// `from_tet` (optional) the surface index of every tet-mesh vertex (-1 off the boundary).
+SurfaceMesh boundary_surface(const TetMesh& mesh, std::vector<int>* to_tet = nullptr, std::vector<int>* from_tet = nullptr);
 
 }  // namespace btr
