@@ -66,19 +66,31 @@ def main():
     md = ["# Calibration of the tumour's uncertainty regions (btr_calibration)", ""]
     colours = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
     for i, (name, rows) in enumerate(studies):
-        for key, form, ls in (("sampled_rank", "sampled", "-"), ("linear_level", "linear", ":")):
+        # Since the discretisation source (2026-12-06): the sampled region also without it.
+        split = "sampled_rank_sources" in rows[0] and any(r["discretisation_mm"] not in ("nan", "") for r in rows)
+        forms = [("sampled_rank", "sampled", "-"), ("linear_level", "linear", ":")]
+        if split:
+            forms.insert(1, ("sampled_rank_sources", "sampled, sources only", "--"))
+        for key, form, ls in forms:
             obs = [coverage(rows, key, p) for p in LEVELS]
             if all(math.isnan(o[0]) for o in obs):
                 continue
             ax.plot(LEVELS, [o[0] for o in obs], ls=ls, marker="o", ms=3, color=colours[i % 4], label=f"{name}, {form}")
             ax.fill_between(LEVELS, [o[1] for o in obs], [o[2] for o in obs], color=colours[i % 4], alpha=0.12)
         md += [f"## {name}: {len(rows)} rows", "",
-               "| level | sampled: observed [95 % interval] | linear: observed [95 % interval] |", "|---|---|---|"]
+               "| level | sampled: observed [95 % interval] | linear: observed [95 % interval] |"
+               + (" sampled, sources only (no discretisation) |" if split else ""),
+               "|---|---|---|" + ("---|" if split else "")]
         for p in (0.5, 0.68, 0.8, 0.9, 0.95, 0.99):
             s, l = coverage(rows, "sampled_rank", p), coverage(rows, "linear_level", p)
-            md.append(f"| {p:.2f} | {s[0]:.3f} [{s[1]:.3f}, {s[2]:.3f}] | {l[0]:.3f} [{l[1]:.3f}, {l[2]:.3f}] |")
-        md += ["", "| scene | rows | median error [mm] | median 95 % radius sampled / linear [mm] | held at 95 % sampled / linear | samples not converged |",
-               "|---|---|---|---|---|---|"]
+            line = f"| {p:.2f} | {s[0]:.3f} [{s[1]:.3f}, {s[2]:.3f}] | {l[0]:.3f} [{l[1]:.3f}, {l[2]:.3f}] |"
+            if split:
+                o = coverage(rows, "sampled_rank_sources", p)
+                line += f" {o[0]:.3f} [{o[1]:.3f}, {o[2]:.3f}] |"
+            md.append(line)
+        md += ["", "| scene | rows | median error [mm] | median 95 % radius sampled / linear [mm] | held at 95 % sampled / linear | samples not converged |"
+               + (" median discretisation shift / sources-only radius [mm] |" if split else ""),
+               "|---|---|---|---|---|---|" + ("---|" if split else "")]
         by = {}
         for r in rows:
             by.setdefault(r["scene"], []).append(r)
@@ -88,8 +100,11 @@ def main():
             hl = sum(float(r["linear_level"]) <= 0.95 for r in rs)
             nc = sum(int(r["samples_not_converged"]) for r in rs[:: max(1, len(set(r["tumour"] for r in rs)))])
             ns = sum(int(r["samples"]) for r in rs[:: max(1, len(set(r["tumour"] for r in rs)))])
-            md.append(f"| {scene_label(scene)} | {len(rs)} | {med('error_mm'):.3f} | {med('sampled_radius_95_mm'):.3f} / "
-                      f"{med('linear_radius_95_mm'):.3f} | {hs} / {hl} | {nc} of {ns} |")
+            line = (f"| {scene_label(scene)} | {len(rs)} | {med('error_mm'):.3f} | {med('sampled_radius_95_mm'):.3f} / "
+                    f"{med('linear_radius_95_mm'):.3f} | {hs} / {hl} | {nc} of {ns} |")
+            if split:
+                line += f" {med('discretisation_mm'):.3f} / {med('sampled_radius_95_sources_mm'):.3f} |"
+            md.append(line)
         md.append("")
     ax.set_xlabel("expected coverage (level of the region)")
     ax.set_ylabel("observed coverage (share of tumours held)")

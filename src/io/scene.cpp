@@ -49,7 +49,7 @@ const std::vector<std::string> kSceneKeys = {
     "regions[].name", "regions[].youngs_modulus", "regions[].relative_stiffness", "regions[].label", "regions[].surface", "prone.cell_labels", "tumour_material",
     "tumour_material.youngs_modulus", "gravity", "prone_gravity", "steps", "preset", "misalignment", "misalignment.rotation_deg",
     "misalignment.translation_mm", "uncertainty", "uncertainty.youngs_modulus_range", "uncertainty.poisson_ratio_range",
-    "uncertainty.gravity_direction_deg", "uncertainty.landmark_sd_mm", "uncertainty.depth_noise_mm", "uncertainty.rigid_pose", "generator.*"};
+    "uncertainty.gravity_direction_deg", "uncertainty.landmark_sd_mm", "uncertainty.depth_noise_mm", "uncertainty.rigid_pose", "uncertainty.discretisation", "generator.*"};
 
 Scene load_scene_fields(const std::string& path);
 }  // namespace
@@ -402,6 +402,7 @@ Scene load_scene_fields(const std::string& path) {
     if (u["landmark_sd_mm"]) s.uncertainty.landmark_sd = 1e-3 * c.number(u["landmark_sd_mm"], "uncertainty.landmark_sd_mm");
     if (u["depth_noise_mm"]) s.uncertainty.depth_noise = 1e-3 * c.number(u["depth_noise_mm"], "uncertainty.depth_noise_mm");
     if (u["rigid_pose"]) s.uncertainty.rigid_pose = c.boolean(u["rigid_pose"], "uncertainty.rigid_pose");
+    if (u["discretisation"]) s.uncertainty.discretisation = c.boolean(u["discretisation"], "uncertainty.discretisation");
     c.load("uncertainty", [&] { validate_uncertainty_sources(s.uncertainty); return 0; });
   }
   if (root["preset"]) s.preset = c.text(root["preset"], "preset");

@@ -32,6 +32,7 @@ UncertaintySources UncertaintySources::none() {
   s.poisson_ratio_range = {0, 0};
   s.gravity_direction_deg = s.landmark_sd = s.depth_noise = 0;
   s.rigid_pose = false;
+  s.discretisation = false;
   return s;
 }
 

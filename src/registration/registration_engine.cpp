@@ -117,19 +117,20 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
 
 const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt) { return entry(opt).prepared; }
 
-RegistrationEngine::Entry& RegistrationEngine::element_entry(Entry& e) {
-  if (e.element) return *e.element;
+RegistrationEngine::Entry& RegistrationEngine::twin_entry(Entry& e, VolumeForm form) {
+  if (e.prepared.scene.material.volume_form == form) return e;
+  if (e.twin) return *e.twin;
   const auto t0 = std::chrono::steady_clock::now();
   auto f = std::make_unique<Entry>();
   PreparedScene& p = f->prepared;
   p.scene = e.prepared.scene;  // the same simulation mesh, materials, regions and rest-shape plan
-  p.scene.material.volume_form = VolumeForm::Element;
+  p.scene.material.volume_form = form;
   p.mesh_note = e.prepared.mesh_note;
   p.mesh_seconds = e.prepared.mesh_seconds;
   p.model = prepare_model(p.scene, p.warnings, unload_, &f->solvers);
   p.prepare_seconds = since(t0);
-  e.element = std::move(f);
-  return *e.element;
+  e.twin = std::move(f);
+  return *e.twin;
 }
 
 RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const RegistrationOptions& opt,
@@ -143,8 +144,8 @@ RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const 
   for (const auto& rep : r.reports)
     if (!rep.converged) why.nodal_stop += (why.nodal_stop.empty() ? "" : "; ") + rep.name + ": " + rep.stop_reason;
   why.nodal_seconds = r.seconds;
-  const bool first = !e.element;
-  Entry& f = element_entry(e);
+  const bool first = !e.twin;
+  Entry& f = twin_entry(e, VolumeForm::Element);
   if (first) why.prepare_seconds = f.prepared.prepare_seconds;
   Scene s = supine;
   s.material.volume_form = VolumeForm::Element;
@@ -251,10 +252,8 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   std::normal_distribution<double> z(0.0, 1.0);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<std::vector<Vec3>> centroids(model.tumours.size());
-  // Per tumour and vertex: the distance of the sampled vertex to its nominal position.
-  std::vector<std::vector<std::vector<double>>> vertex_distances(model.tumours.size());
-  for (size_t i = 0; i < nominal.tumours.size(); ++i)
-    vertex_distances[i].resize(static_cast<size_t>(nominal.tumours[i].registered.V.rows()));
+  // Per tumour and sample: its surface vertices' offsets from their nominal positions.
+  std::vector<std::vector<Points>> vertex_offsets(model.tumours.size());
   const auto t0 = std::chrono::steady_clock::now();
   for (int k = 0; k < samples; ++k) {
     // Every draw is made whether or not its source is used, so a seed gives the same inputs.
@@ -297,9 +296,7 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
         centroids[i].push_back(r.tumours[i].centroid);
         const Points& V = r.tumours[i].registered.V;
         const Points& V0 = nominal.tumours[i].registered.V;
-        if (V.rows() == V0.rows())  // the same embedding: vertex for vertex
-          for (Eigen::Index v = 0; v < V.rows(); ++v)
-            vertex_distances[i][static_cast<size_t>(v)].push_back((V.row(v) - V0.row(v)).norm());
+        if (V.rows() == V0.rows()) vertex_offsets[i].push_back(V - V0);  // the same embedding: vertex for vertex
       }
     } catch (const std::exception& err) {
       ++out.failed;
@@ -307,21 +304,48 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
     }
   }
   out.seconds_per_sample = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / samples;
+  // The element form's own error, which none of the sources above draws (on a truth our
+  // elements did not make it was as large as their spread: BENCHMARKS.md, issue 14).
+  std::vector<Vec3> shift(centroids.size(), Vec3::Zero());
+  std::vector<Points> vertex_shift(centroids.size());
+  if (src.discretisation) {
+    const auto t1 = std::chrono::steady_clock::now();
+    const std::optional<RegistrationResult> ref = discretisation_reference(e, scene, opt, nominal, notes);
+    out.discretisation_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    if (ref) {
+      out.discretisation_estimated = true;
+      for (size_t i = 0; i < shift.size(); ++i) {
+        shift[i] = ref->tumours[i].centroid - nominal.tumours[i].centroid;
+        const Points& V = ref->tumours[i].registered.V;
+        if (V.rows() == nominal.tumours[i].registered.V.rows()) vertex_shift[i] = V - nominal.tumours[i].registered.V;
+      }
+    }
+  }
   for (size_t i = 0; i < centroids.size(); ++i) {
     SampledUncertainty::Tumour t;
     const auto& c = centroids[i];
     if (c.size() >= 2) {
       Vec3 mean = Vec3::Zero();
       for (const Vec3& p : c) mean += p / static_cast<double>(c.size());
-      std::vector<double> d;
+      std::vector<Vec3> offsets;
       for (const Vec3& p : c) {
         t.covariance += (p - mean) * (p - mean).transpose() / static_cast<double>(c.size() - 1);
-        d.push_back((p - nominal.tumours[i].centroid).norm());
+        offsets.push_back(p - nominal.tumours[i].centroid);
       }
       t.mean_shift = mean - nominal.tumours[i].centroid;
-      t.radius_95 = percentile_95(d);
+      t.radius_95_sources = percentile_95(sampled_distances(offsets, Vec3::Zero()));
+      t.discretisation = shift[i];
+      t.covariance += shift[i] * shift[i].transpose();
+      t.radius_95 = percentile_95(sampled_distances(offsets, shift[i]));
       t.centroids = c;
-      for (auto& dv : vertex_distances[i]) t.vertex_radius_95.push_back(percentile_95(std::move(dv)));
+      const Eigen::Index nv = nominal.tumours[i].registered.V.rows();
+      if (!vertex_offsets[i].empty())
+        for (Eigen::Index v = 0; v < nv; ++v) {
+          std::vector<Vec3> o;
+          for (const Points& P : vertex_offsets[i]) o.push_back(P.row(v).transpose());
+          const Vec3 d = vertex_shift[i].rows() == nv ? Vec3(vertex_shift[i].row(v).transpose()) : Vec3::Zero();
+          t.vertex_radius_95.push_back(percentile_95(sampled_distances(o, d)));
+        }
     }
     out.tumours.push_back(t);
   }
@@ -334,19 +358,55 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
   return out;
 }
 
+std::optional<RegistrationResult> RegistrationEngine::discretisation_reference(Entry& e, const Scene& scene,
+                                                                              const RegistrationOptions& opt,
+                                                                              const RegistrationResult& nominal,
+                                                                              std::vector<std::string>& notes) {
+  if (nominal.volume_form != VolumeForm::Element) {
+    notes.push_back("discretisation not estimated: the registration used the nodal volume form, the finer of the two");
+    return std::nullopt;
+  }
+  if (nominal.volume_form_fallback) {
+    notes.push_back("discretisation not estimated: the nodal volume form did not converge on this scene");
+    return std::nullopt;
+  }
+  Entry& n = twin_entry(e, VolumeForm::Nodal);
+  Scene s = scene;
+  s.material.volume_form = VolumeForm::Nodal;
+  RegistrationOptions o = opt;
+  o.uncertainty.enabled = false;
+  try {
+    RegistrationResult r = run_registration(s, n.prepared.model, o, {}, &n.solvers);
+    if (!r.converged) {
+      std::string why;
+      for (const auto& rep : r.reports)
+        if (!rep.converged) why += (why.empty() ? "" : "; ") + rep.name + ": " + without_figures(rep.stop_reason);
+      notes.push_back("discretisation not estimated: the nodal reference did not converge (" + why + ")");
+      return std::nullopt;
+    }
+    if (r.tumours.size() != nominal.tumours.size()) throw SolverError("the nodal reference has another tumour count");
+    notes.push_back("discretisation: the nominal inputs registered again with the nodal volume form, whose shift is "
+                    "taken as the element form's error (Gaussian along it, its length the sd)");
+    return r;
+  } catch (const std::exception& err) {
+    notes.push_back(std::string("discretisation not estimated: the nodal reference failed (") + err.what() + ")");
+    return std::nullopt;
+  }
+}
+
 RegistrationEngine::Entry& RegistrationEngine::nominal_entry(Entry& e, const RegistrationResult& nominal) {
-  return nominal.volume_form_fallback ? element_entry(e) : e;
+  return nominal.volume_form_fallback ? twin_entry(e, VolumeForm::Element) : e;
 }
 
 int RegistrationEngine::solvers_built() const {
   int n = 0;
-  for (const auto& [k, e] : entries_) n += e->solvers.built() + (e->element ? e->element->solvers.built() : 0);
+  for (const auto& [k, e] : entries_) n += e->solvers.built() + (e->twin ? e->twin->solvers.built() : 0);
   return n;
 }
 
 int RegistrationEngine::solvers_reused() const {
   int n = 0;
-  for (const auto& [k, e] : entries_) n += e->solvers.reused() + (e->element ? e->element->solvers.reused() : 0);
+  for (const auto& [k, e] : entries_) n += e->solvers.reused() + (e->twin ? e->twin->solvers.reused() : 0);
   return n;
 }
 

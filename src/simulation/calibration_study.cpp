@@ -97,13 +97,23 @@ void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions&
         row.draw = k;
         row.tilt_deg = Eigen::AngleAxisd(tilt.linear()).angle() * 180 / M_PI;
         row.error = t.centroid_distance;
-        row.sampled_radius_95 = row.sampled_rank = nan;
-        if (i < su.tumours.size()) {
+        row.sampled_radius_95 = row.sampled_rank = row.sampled_radius_95_sources = row.sampled_rank_sources = nan;
+        row.discretisation = nan;
+        if (i < su.tumours.size() && !su.tumours[i].centroids.empty()) {
           const auto& st = su.tumours[i];
-          int nearer = 0;
-          for (const Vec3& c : st.centroids) nearer += (c - t.centroid).norm() < row.error;
+          std::vector<Vec3> offsets;
+          for (const Vec3& c : st.centroids) offsets.push_back(c - t.centroid);
+          // The truth's rank among the region's distances: with the discretisation and without.
+          const auto rank = [&](const Vec3& shift) {
+            const std::vector<double> d = sampled_distances(offsets, shift);
+            const auto nearer = std::count_if(d.begin(), d.end(), [&](double x) { return x < row.error; });
+            return static_cast<double>(nearer) / static_cast<double>(d.size());
+          };
           row.sampled_radius_95 = st.radius_95;
-          if (!st.centroids.empty()) row.sampled_rank = static_cast<double>(nearer) / static_cast<double>(st.centroids.size());
+          row.sampled_rank = rank(st.discretisation);
+          row.sampled_radius_95_sources = st.radius_95_sources;
+          row.sampled_rank_sources = rank(Vec3::Zero());
+          if (su.discretisation_estimated) row.discretisation = st.discretisation.norm();
         }
         row.linear_radius_95 = t.uncertainty ? t.uncertainty->radius_95 : nan;
         row.linear_level = t.uncertainty ? probability_within(t.uncertainty->covariance, row.error) : nan;
@@ -124,14 +134,16 @@ void run_calibration(const std::vector<Scene>& scenes, const CalibrationOptions&
 
 void write_calibration_csv_header(std::ostream& out) {
   out << "scene,draw,tumour,tilt_deg,error_mm,sampled_radius_95_mm,sampled_rank,linear_radius_95_mm,linear_level,samples,"
-         "samples_not_converged,converged,seconds,youngs_modulus_Pa,youngs_modulus_log_sd\n";
+         "samples_not_converged,converged,seconds,youngs_modulus_Pa,youngs_modulus_log_sd,sampled_radius_95_sources_mm,"
+         "sampled_rank_sources,discretisation_mm\n";
 }
 
 void write_calibration_csv_row(std::ostream& out, const CalibrationRow& r) {
   out << csv_field(r.scene) << ',' << r.draw << ',' << csv_field(r.tumour) << ',' << std::setprecision(6) << r.tilt_deg << ',' << r.error * 1e3 << ','
       << r.sampled_radius_95 * 1e3 << ',' << r.sampled_rank << ',' << r.linear_radius_95 * 1e3 << ',' << r.linear_level << ','
       << r.samples << ',' << r.samples_not_converged << ',' << (r.converged ? 1 : 0) << ',' << std::setprecision(4) << r.seconds
-      << ',' << std::setprecision(6) << r.youngs_modulus << ',' << r.youngs_modulus_log_sd << '\n';
+      << ',' << std::setprecision(6) << r.youngs_modulus << ',' << r.youngs_modulus_log_sd << ',' << r.sampled_radius_95_sources * 1e3
+      << ',' << r.sampled_rank_sources << ',' << r.discretisation * 1e3 << '\n';
 }
 
 std::pair<double, double> wilson_interval(int k, int n) {

@@ -99,7 +99,11 @@ Json tumour_report(const TumourResult& t, const SampledUncertainty* sampled, siz
   if (sampled && i < sampled->tumours.size()) {
     const auto& u = sampled->tumours[i];
     j["uncertainty_sampled"] = {
-        {"radius_95_mm", num(u.radius_95 * 1e3)}, {"covariance_mm2", mat(u.covariance, 1e6)}, {"mean_shift_mm", vec_mm(u.mean_shift)}};
+        {"radius_95_mm", num(u.radius_95 * 1e3)},
+        {"radius_95_sources_mm", num(u.radius_95_sources * 1e3)},  // without the discretisation
+        {"covariance_mm2", mat(u.covariance, 1e6)},
+        {"mean_shift_mm", vec_mm(u.mean_shift)},
+        {"discretisation_mm", vec_mm(u.discretisation)}};
     if (!u.vertex_radius_95.empty()) {
       std::vector<double> m = u.vertex_radius_95;
       std::sort(m.begin(), m.end());
@@ -223,6 +227,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                                 {"not_converged", r.sampled_uncertainty->not_converged},
                                 {"failed", r.sampled_uncertainty->failed},
                                 {"seconds_per_sample", num(r.sampled_uncertainty->seconds_per_sample)},
+                                {"discretisation_estimated", r.sampled_uncertainty->discretisation_estimated},
+                                {"discretisation_seconds", num(r.sampled_uncertainty->discretisation_seconds)},
                                 {"note", r.sampled_uncertainty->note}};
   if (j.contains("uncertainty") || j.contains("uncertainty_sampled")) {  // the distributions propagated
     const UncertaintySources& u = scene.uncertainty;
@@ -231,7 +237,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                                 {"gravity_direction_deg", num(u.gravity_direction_deg)},
                                 {"landmark_sd_mm", num(u.landmark_sd * 1e3)},
                                 {"depth_noise_mm", num(u.depth_noise * 1e3)},
-                                {"rigid_pose", u.rigid_pose}};
+                                {"rigid_pose", u.rigid_pose},
+                                {"discretisation", u.discretisation}};
   }
   j["landmark_residual_mm"] = {{"mean", num(r.landmark_residual_mean * 1e3)}, {"max", num(r.landmark_residual_max * 1e3)}};
   j["skin_to_supine_surface_mm"] = {{"mean", num(r.skin_distance_mean * 1e3)}, {"max", num(r.skin_distance_max * 1e3)}};

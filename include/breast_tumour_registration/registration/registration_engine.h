@@ -10,6 +10,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,7 +72,10 @@ class RegistrationEngine {
   /// draws a material estimates the unloaded shape again. E is not sampled where the scene
   /// estimates it (the stiffness step does, from the sampled landmarks), and the noise not on a
   /// point cloud; the note says so. The samples use the volume form `nominal` was computed
-  /// with (the element form where it fell back) and do not fall back one by one.
+  /// with (the element form where it fell back) and do not fall back one by one. With the
+  /// discretisation source (on by default) and the element form, the nominal inputs are
+  /// registered once more with the nodal form, and the region takes that shift as the element
+  /// form's own error (SampledUncertainty::Tumour::discretisation).
   SampledUncertainty sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources, int samples,
                                         unsigned seed, const RegistrationResult& nominal);
 
@@ -89,13 +93,21 @@ class RegistrationEngine {
   struct Entry {
     PreparedScene prepared;
     StepSolvers solvers;
-    /// With the nodal volume form: the same mesh prepared with the element form, made when a
-    /// registration first falls back to it (its own unloaded shape and solvers)
-    std::unique_ptr<Entry> element;
+    /// The same mesh prepared with the other volume form (its own unloaded shape and solvers),
+    /// made on first use: the element form where a nodal registration falls back to it, the
+    /// nodal form where sampling estimates the element form's discretisation error
+    std::unique_ptr<Entry> twin;
   };
   Entry& entry(const RegistrationOptions& opt);
-  /// e's element-form twin, prepared on first use
-  Entry& element_entry(Entry& e);
+  /// e's twin with the volume form `form` (e's own is the other), prepared on first use
+  Entry& twin_entry(Entry& e, VolumeForm form);
+  /// The model's discretisation error as sampling takes it (UncertaintySources::discretisation):
+  /// the nominal inputs (`scene`, on e's mesh) registered again with the nodal volume form; none,
+  /// with a note saying why, for a nominal already nodal or fallen back, or a reference that did
+  /// not converge or failed.
+  std::optional<RegistrationResult> discretisation_reference(Entry& e, const Scene& scene, const RegistrationOptions& opt,
+                                                             const RegistrationResult& nominal,
+                                                             std::vector<std::string>& notes);
   /// The entry `nominal` was computed on: e, or its element-form twin where it fell back
   Entry& nominal_entry(Entry& e, const RegistrationResult& nominal);
   RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);

@@ -214,12 +214,21 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
 /// and what the pipeline itself does, stopping criteria included.
 struct SampledUncertainty {
   struct Tumour {
-    Mat3 covariance = Mat3::Zero();  ///< of the sampled centroids about their mean, supine frame [m^2]
-    double radius_95 = 0;            ///< [m] the 95th percentile of the distance to the nominal centroid
+    /// of the sampled centroids about their mean, plus the discretisation's d d^T, supine frame [m^2]
+    Mat3 covariance = Mat3::Zero();
+    /// [m] the 95th percentile of the distance to the nominal centroid, over the samples
+    /// combined with the discretisation error (sampled_distances)
+    double radius_95 = 0;
+    double radius_95_sources = 0;    ///< [m] the same over the samples alone (the listed sources)
+    /// The element form's discretisation error as estimated (UncertaintySources::discretisation):
+    /// the nodal reference's centroid minus the nominal one, supine frame [m]; zero where it was
+    /// not estimated.
+    Vec3 discretisation = Vec3::Zero();
     Vec3 mean_shift = Vec3::Zero();  ///< sample mean minus the nominal centroid [m]
     std::vector<Vec3> centroids;     ///< every finished sample's centroid, supine frame [m]
     /// Per vertex of the registered tumour surface: the 95th percentile of its distance to the
-    /// nominal position over the samples [m] (the margin shell grows the surface by it).
+    /// nominal position over the samples, combined with that vertex's discretisation shift [m]
+    /// (the margin shell grows the surface by it).
     std::vector<double> vertex_radius_95;
   };
   std::vector<Tumour> tumours;
@@ -227,11 +236,23 @@ struct SampledUncertainty {
   int not_converged = 0;  ///< of them, not converged (kept: what the pipeline would have given)
   int failed = 0;         ///< that threw (left out)
   double seconds_per_sample = 0;
+  bool discretisation_estimated = false;  ///< the nodal reference converged and its shift is in the region
+  double discretisation_seconds = 0;      ///< the nodal reference registration [s] (0: not run)
   std::string note;       ///< what was not sampled, and why
 };
 
 /// The 95th percentile of the distances, by the nearest rank (0 for none).
 double percentile_95(std::vector<double> distances);
+
+/// How many equally likely quantiles of the standard normal sampled_distances pairs each
+/// sample with: (k + 0.5) / 20, k = 0..19, out to 1.96 sd.
+inline constexpr int kDiscretisationQuantiles = 20;
+
+/// The distances from the nominal point of sampled offsets (sample minus nominal) with a
+/// discretisation error taken as Gaussian along `shift`, its length the sd: every offset o paired
+/// with each quantile z (kDiscretisationQuantiles), |o + z shift|, a deterministic convolution of
+/// the samples with that normal. A zero shift gives the offsets' norms.
+std::vector<double> sampled_distances(const std::vector<Vec3>& offsets, const Vec3& shift);
 
 /// The two horizontal axes the gravity-direction source tilts about (both the linearisation and
 /// the sampling): a unit vector orthogonal to `gravity`, then gravity's direction crossed with it.

@@ -39,6 +39,10 @@ struct CalibrationRow {
   /// sampled centroids nearer the nominal one than the truth: the smallest level whose region
   /// holds it).
   double sampled_radius_95 = 0, sampled_rank = 0;
+  /// The same from the listed sources alone, without the discretisation error (the region
+  /// before UncertaintySources::discretisation), and that error's estimated size |shift| [m]
+  /// (NaN where it was not estimated).
+  double sampled_radius_95_sources = 0, sampled_rank_sources = 0, discretisation = 0;
   /// Linearised region: its 95 % radius [m] and P(|X| <= error) under its Gaussian (NaN when
   /// not computed).
   double linear_radius_95 = 0, linear_level = 0;
