@@ -245,8 +245,10 @@ struct SampledUncertainty {
 double percentile_95(std::vector<double> distances);
 
 /// How many equally likely quantiles of the standard normal sampled_distances pairs each
-/// sample with: (k + 0.5) / 20, k = 0..19, out to 1.96 sd.
-inline constexpr int kDiscretisationQuantiles = 20;
+/// sample with: (k + 0.5) / 19, k = 0..18, out to 1.94 sd. Odd, so that with 16 or 32 samples
+/// 95 % of the pairs is not a whole number: the nearest-rank radius then holds exactly the
+/// truths whose rank among the pairs is at most 0.95 (CalibrationRow::sampled_rank).
+inline constexpr int kDiscretisationQuantiles = 19;
 
 /// The distances from the nominal point of sampled offsets (sample minus nominal) with a
 /// discretisation error taken as Gaussian along `shift`, its length the sd: every offset o paired
