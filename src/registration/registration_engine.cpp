@@ -335,7 +335,6 @@ SampledUncertainty RegistrationEngine::sample(Entry& e, const Scene& scene, cons
       t.mean_shift = mean - nominal.tumours[i].centroid;
       t.radius_95_sources = percentile_95(sampled_distances(offsets, Vec3::Zero()));
       t.discretisation = shift[i];
-      t.covariance += shift[i] * shift[i].transpose();
       t.radius_95 = percentile_95(sampled_distances(offsets, shift[i]));
       t.centroids = c;
       const Eigen::Index nv = nominal.tumours[i].registered.V.rows();
@@ -386,7 +385,7 @@ std::optional<RegistrationResult> RegistrationEngine::discretisation_reference(E
     }
     if (r.tumours.size() != nominal.tumours.size()) throw SolverError("the nodal reference has another tumour count");
     notes.push_back("discretisation: the nominal inputs registered again with the nodal volume form, whose shift is "
-                    "taken as the element form's error (Gaussian along it, its length the sd)");
+                    "taken as the element form's error: every sample moved by it");
     return r;
   } catch (const std::exception& err) {
     notes.push_back(std::string("discretisation not estimated: the nodal reference failed (") + err.what() + ")");

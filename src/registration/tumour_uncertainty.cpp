@@ -267,27 +267,8 @@ double percentile_95(std::vector<double> d) {
 
 std::vector<double> sampled_distances(const std::vector<Vec3>& offsets, const Vec3& shift) {
   std::vector<double> d;
-  if (shift.isZero(0.0)) {
-    for (const Vec3& o : offsets) d.push_back(o.norm());
-    return d;
-  }
-  // The standard normal's quantiles at (k + 1/2) / n, by bisection on its distribution function.
-  static const std::array<double, kDiscretisationQuantiles> z = [] {
-    std::array<double, kDiscretisationQuantiles> q{};
-    for (int k = 0; k < kDiscretisationQuantiles; ++k) {
-      const double p = (k + 0.5) / kDiscretisationQuantiles;
-      double lo = -10, hi = 10;
-      for (int it = 0; it < 200; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
-      }
-      q[static_cast<size_t>(k)] = 0.5 * (lo + hi);
-    }
-    return q;
-  }();
-  d.reserve(offsets.size() * z.size());
-  for (const Vec3& o : offsets)
-    for (double zk : z) d.push_back((o + zk * shift).norm());
+  d.reserve(offsets.size());
+  for (const Vec3& o : offsets) d.push_back((o + shift).norm());
   return d;
 }
 

@@ -1,5 +1,6 @@
 // Where the tumour may be (issue 14): the linearised centroid uncertainty against full re-solves.
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <filesystem>
 #include <optional>
@@ -657,6 +658,7 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
   RegistrationEngine engine(s);
   const RegistrationResult nominal = engine.solve(o);
   UncertaintyOptions u;
+  u.sources.discretisation = false;  // its own test below
   const SampledUncertainty a = engine.sample_uncertainty(o, u, 4, 3, nominal), b = engine.sample_uncertainty(o, u, 4, 3, nominal);
   ASSERT_EQ(a.samples, 4);
   EXPECT_EQ(a.failed, 0);
@@ -714,6 +716,99 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
   expect_throw_with<InputError>([&] { engine.sample_uncertainty(o, u, 1, 3, nominal); }, "at least 2 samples");
   EXPECT_EQ(percentile_95({3, 1, 2}), 3.0);
   EXPECT_EQ(percentile_95({}), 0.0);
+}
+
+// The element form's discretisation error as a source of the sampled region: the nominal inputs
+// registered again with the nodal volume form on the same mesh, and every sample moved by its
+// shift of each tumour.
+TEST(Uncertainty, SamplingTakesTheNodalReferencesShiftAsTheElementFormsDiscretisationError) {
+  // sampled_distances: each offset moved by the shift (no shift: the offsets' norms).
+  const std::vector<Vec3> offsets = {Vec3(0.001, 0, 0), Vec3(0, 0.002, 0)};
+  EXPECT_EQ(sampled_distances(offsets, Vec3::Zero()), (std::vector<double>{0.001, 0.002}));
+  const std::vector<double> moved = sampled_distances(offsets, Vec3(-0.001, 0, 0));
+  ASSERT_EQ(moved.size(), 2u);
+  EXPECT_NEAR(moved[0], 0.0, 1e-15);
+  EXPECT_NEAR(moved[1], std::sqrt(5.0) * 0.001, 1e-15);
+
+  const Scene& s = btr::test::coarse_phantom_scene();
+  const RegistrationOptions o = preset_options("fast");
+  RegistrationEngine engine(s);
+  const RegistrationResult nominal = engine.solve(o);
+  ASSERT_EQ(nominal.volume_form, VolumeForm::Element);  // auto at nu 0.49
+  Scene ns = s;
+  ns.material.volume_form = VolumeForm::Nodal;
+  RegistrationEngine nodal_engine(ns);
+  const RegistrationResult nodal = nodal_engine.solve(o);
+  ASSERT_TRUE(nominal.converged && nodal.converged);
+  ASSERT_FALSE(nodal.volume_form_fallback);
+  UncertaintyOptions u;
+  u.sources = UncertaintySources::none();
+  u.sources.landmark_sd = 0.0015;  // one source is enough here
+  u.sources.discretisation = true;
+  const SampledUncertainty a = engine.sample_uncertainty(o, u, 4, 3, nominal);
+  ASSERT_TRUE(a.discretisation_estimated) << a.note;
+  EXPECT_GT(a.discretisation_seconds, 0.0);
+  EXPECT_NE(a.note.find("nodal volume form"), std::string::npos) << a.note;
+  ASSERT_EQ(a.tumours.size(), nominal.tumours.size());
+  for (size_t i = 0; i < a.tumours.size(); ++i) {
+    const auto& t = a.tumours[i];
+    const Vec3 shift = nodal.tumours[i].centroid - nominal.tumours[i].centroid;
+    EXPECT_GT(shift.norm(), 1e-5) << "the two forms must differ for this test to mean anything";
+    EXPECT_LT((t.discretisation - shift).norm(), 1e-3 * shift.norm()) << nominal.tumours[i].name;
+    // The radius is the samples' moved by that shift, and the sources' alone beside it.
+    std::vector<Vec3> offsets_i;
+    for (const Vec3& c : t.centroids) offsets_i.push_back(c - nominal.tumours[i].centroid);
+    EXPECT_DOUBLE_EQ(t.radius_95, percentile_95(sampled_distances(offsets_i, t.discretisation)));
+    EXPECT_DOUBLE_EQ(t.radius_95_sources, percentile_95(sampled_distances(offsets_i, Vec3::Zero())));
+    Vec3 mean = Vec3::Zero();
+    for (const Vec3& c : t.centroids) mean += c / static_cast<double>(t.centroids.size());
+    Mat3 sampled = Mat3::Zero();
+    for (const Vec3& c : t.centroids) sampled += (c - mean) * (c - mean).transpose() / static_cast<double>(t.centroids.size() - 1);
+    EXPECT_LT((t.covariance - sampled).norm(), 1e-12);  // the samples' own, about their mean
+    ASSERT_EQ(t.vertex_radius_95.size(), static_cast<size_t>(nominal.tumours[i].registered.V.rows()));
+  }
+  // With no other source every sample is the nominal registration: the region is the shift
+  // itself, at the centroid and at every vertex of the margin shell.
+  UncertaintyOptions only;
+  only.sources = UncertaintySources::none();
+  only.sources.discretisation = true;
+  const SampledUncertainty z = engine.sample_uncertainty(o, only, 2, 3, nominal);
+  ASSERT_TRUE(z.discretisation_estimated) << z.note;
+  for (size_t i = 0; i < z.tumours.size(); ++i) {
+    EXPECT_NEAR(z.tumours[i].radius_95, (nodal.tumours[i].centroid - nominal.tumours[i].centroid).norm(), 1e-9);
+    EXPECT_LT(z.tumours[i].radius_95_sources, 1e-12);
+    const Points& V = nodal.tumours[i].registered.V;
+    ASSERT_EQ(z.tumours[i].vertex_radius_95.size(), static_cast<size_t>(V.rows()));
+    for (Eigen::Index v = 0; v < V.rows(); ++v)
+      EXPECT_NEAR(z.tumours[i].vertex_radius_95[static_cast<size_t>(v)], (V.row(v) - nominal.tumours[i].registered.V.row(v)).norm(), 1e-9);
+  }
+  // Left out: the radius is the sources' alone, and no reference is run.
+  u.sources.discretisation = false;
+  const SampledUncertainty b = engine.sample_uncertainty(o, u, 4, 3, nominal);
+  EXPECT_FALSE(b.discretisation_estimated);
+  EXPECT_EQ(b.discretisation_seconds, 0.0);
+  for (size_t i = 0; i < b.tumours.size(); ++i) {
+    EXPECT_EQ(b.tumours[i].radius_95, b.tumours[i].radius_95_sources);
+    EXPECT_EQ(b.tumours[i].radius_95_sources, a.tumours[i].radius_95_sources);  // the same samples
+    EXPECT_TRUE(b.tumours[i].discretisation.isZero(0.0));
+  }
+  // A registration already nodal has no finer form to compare with: said, not estimated.
+  u.sources.discretisation = true;
+  const SampledUncertainty c = nodal_engine.sample_uncertainty(o, u, 2, 3, nodal);
+  EXPECT_FALSE(c.discretisation_estimated);
+  EXPECT_NE(c.note.find("discretisation not estimated: the registration used the nodal volume form"), std::string::npos) << c.note;
+  // The report states both radii, the shift and the source.
+  RegistrationResult with = nominal;
+  with.sampled_uncertainty = a;
+  const PreparedScene& prep = engine.prepare(o);
+  const std::string d = btr::test::temp_dir();
+  write_registration_outputs(d, prep.scene, prep.model, with, 0);
+  std::ifstream report(d + "/report.json");
+  const nlohmann::json j = nlohmann::json::parse(report);
+  EXPECT_TRUE(j.at("uncertainty_sampled").at("discretisation_estimated").get<bool>());
+  const auto& t0 = j.at("tumours")[0].at("uncertainty_sampled");
+  EXPECT_NEAR(t0.at("radius_95_sources_mm").get<double>(), a.tumours[0].radius_95_sources * 1e3, 1e-9);
+  EXPECT_NEAR(t0.at("discretisation_mm")[2].get<double>(), a.tumours[0].discretisation.z() * 1e3, 1e-9);
 }
 
 TEST(MarginShell, GrowsASphereOutwardsByTheBoundAtEveryVertexWhateverItsOrientation) {

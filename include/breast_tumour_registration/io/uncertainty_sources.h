@@ -37,11 +37,11 @@ struct UncertaintySources {
   bool rigid_pose = true;
   /// The model's own discretisation error, which no other source draws: where the region is
   /// sampled with the element volume form, the nominal inputs are registered once more with the
-  /// nodal form (which locks less), and its shift of each tumour (and surface vertex) is taken
-  /// as Gaussian along the shift with its length as sd (SampledUncertainty::Tumour::discretisation).
-  /// On a truth our elements did not make that shift pointed along the element form's error and
-  /// was 0.3 to 0.8 of it (BENCHMARKS.md, issue 14). Not in the linearised region (the reference
-  /// costs 2 to 3 registrations). false: left out.
+  /// nodal form (which locks less), and every sample is moved by its shift of each tumour (and
+  /// surface vertex): SampledUncertainty::Tumour::discretisation. On a truth our elements did not
+  /// make that shift pointed along the element form's error (cosine 0.56 to 1.00) and was 0.2 to
+  /// 1.3 times as long (BENCHMARKS.md, issue 14). Not in the linearised region (the reference costs
+  /// 2 to 3 registrations). false: left out.
   bool discretisation = true;
 
   bool samples_youngs_modulus() const { return youngs_modulus_range[1] > 0; }

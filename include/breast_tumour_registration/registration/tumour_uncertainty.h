@@ -214,20 +214,19 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
 /// and what the pipeline itself does, stopping criteria included.
 struct SampledUncertainty {
   struct Tumour {
-    /// of the sampled centroids about their mean, plus the discretisation's d d^T, supine frame [m^2]
-    Mat3 covariance = Mat3::Zero();
-    /// [m] the 95th percentile of the distance to the nominal centroid, over the samples
-    /// combined with the discretisation error (sampled_distances)
+    Mat3 covariance = Mat3::Zero();  ///< of the sampled centroids about their mean, supine frame [m^2]
+    /// [m] the 95th percentile of the distance to the nominal centroid over the samples, each
+    /// moved by the discretisation error (sampled_distances)
     double radius_95 = 0;
     double radius_95_sources = 0;    ///< [m] the same over the samples alone (the listed sources)
     /// The element form's discretisation error as estimated (UncertaintySources::discretisation):
     /// the nodal reference's centroid minus the nominal one, supine frame [m]; zero where it was
-    /// not estimated.
+    /// not estimated. The region's samples are moved by it (mean_shift is theirs before).
     Vec3 discretisation = Vec3::Zero();
     Vec3 mean_shift = Vec3::Zero();  ///< sample mean minus the nominal centroid [m]
     std::vector<Vec3> centroids;     ///< every finished sample's centroid, supine frame [m]
     /// Per vertex of the registered tumour surface: the 95th percentile of its distance to the
-    /// nominal position over the samples, combined with that vertex's discretisation shift [m]
+    /// nominal position over the samples, each moved by that vertex's discretisation shift [m]
     /// (the margin shell grows the surface by it).
     std::vector<double> vertex_radius_95;
   };
@@ -244,16 +243,12 @@ struct SampledUncertainty {
 /// The 95th percentile of the distances, by the nearest rank (0 for none).
 double percentile_95(std::vector<double> distances);
 
-/// How many equally likely quantiles of the standard normal sampled_distances pairs each
-/// sample with: (k + 0.5) / 19, k = 0..18, out to 1.94 sd. Odd, so that with 16 or 32 samples
-/// 95 % of the pairs is not a whole number: the nearest-rank radius then holds exactly the
-/// truths whose rank among the pairs is at most 0.95 (CalibrationRow::sampled_rank).
-inline constexpr int kDiscretisationQuantiles = 19;
-
-/// The distances from the nominal point of sampled offsets (sample minus nominal) with a
-/// discretisation error taken as Gaussian along `shift`, its length the sd: every offset o paired
-/// with each quantile z (kDiscretisationQuantiles), |o + z shift|, a deterministic convolution of
-/// the samples with that normal. A zero shift gives the offsets' norms.
+/// The distances from the nominal point of sampled offsets (sample minus nominal) with the
+/// element form's estimated discretisation error: each offset moved by `shift`, the nodal
+/// reference's displacement from the nominal (|o + shift|). The shift is taken as the bias it
+/// was measured to be, not as a spread: on a truth our elements did not make it pointed along the
+/// element form's error (cosine 0.56 to 1.00); taken as Gaussian along itself instead, the
+/// region held 84 % at its 68 % level (BENCHMARKS.md, issue 14). A zero shift gives the norms.
 std::vector<double> sampled_distances(const std::vector<Vec3>& offsets, const Vec3& shift);
 
 /// The two horizontal axes the gravity-direction source tilts about (both the linearisation and
