@@ -221,6 +221,8 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
                               : "the supine landmarks' localisation (landmark_sd_mm), except through an estimated "
                                 "Young's modulus: its effect through the surface step's start is drawn by "
                                 "--uncertainty sampling",
+                          "the element form's discretisation error: estimated by --uncertainty sampling "
+                          "(uncertainty.discretisation)",
                           "model error beyond the listed sources"}}};
   if (r.sampled_uncertainty)
     j["uncertainty_sampled"] = {{"samples", r.sampled_uncertainty->samples},

@@ -170,9 +170,12 @@ int main(int argc, char** argv) {
     if (r.sampled_uncertainty) {
       const SampledUncertainty& su = *r.sampled_uncertainty;
       for (size_t i = 0; i < su.tumours.size() && i < r.tumours.size(); ++i)
-        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm), mean shift %.2f mm, margin shell up to %.2f mm%s\n",
+        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm; sources alone %.2f mm, discretisation %.2f mm), "
+                    "mean shift %.2f mm, margin shell up to %.2f mm%s\n",
                     r.tumours[i].name.c_str(), su.tumours[i].radius_95 * 1e3,
-                    r.tumours[i].uncertainty ? r.tumours[i].uncertainty->radius_95 * 1e3 : 0.0, su.tumours[i].mean_shift.norm() * 1e3,
+                    r.tumours[i].uncertainty ? r.tumours[i].uncertainty->radius_95 * 1e3 : 0.0,
+                    su.tumours[i].radius_95_sources * 1e3, su.tumours[i].discretisation.norm() * 1e3,
+                    su.tumours[i].mean_shift.norm() * 1e3,
                     su.tumours[i].vertex_radius_95.empty()
                         ? 0.0
                         : *std::max_element(su.tumours[i].vertex_radius_95.begin(), su.tumours[i].vertex_radius_95.end()) * 1e3,
@@ -180,8 +183,10 @@ int main(int argc, char** argv) {
                                                          ? "; holds the true centroid"
                                                          : "; the true centroid lies outside")
                                                   : "");
-      std::printf("[sampled ] %d samples (%d not converged, %d failed), %.3f s each%s%s\n", su.samples, su.not_converged,
-                  su.failed, su.seconds_per_sample, su.note.empty() ? "" : ": ", su.note.c_str());
+      std::printf("[sampled ] %d samples (%d not converged, %d failed), %.3f s each, the discretisation's nodal reference "
+                  "%.3f s%s%s\n",
+                  su.samples, su.not_converged, su.failed, su.seconds_per_sample, su.discretisation_seconds,
+                  su.note.empty() ? "" : ": ", su.note.c_str());
     }
     const auto files = write_registration_outputs(out_dir, sim, model, r, prepare);
     std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "

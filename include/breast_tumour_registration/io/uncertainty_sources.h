@@ -38,9 +38,11 @@ struct UncertaintySources {
   /// The model's own discretisation error, which no other source draws: where the region is
   /// sampled with the element volume form, the nominal inputs are registered once more with the
   /// nodal form (which locks less), and every sample is moved by its shift of each tumour (and
-  /// surface vertex): SampledUncertainty::Tumour::discretisation. On a truth our elements did not
-  /// make that shift pointed along the element form's error (cosine 0.56 to 1.00) and was 0.2 to
-  /// 1.3 times as long (BENCHMARKS.md, issue 14). Not in the linearised region (the reference costs
+  /// surface vertex): SampledUncertainty::Tumour::discretisation. On truth our elements did not
+  /// make (the phantom's quadratic truth, SfePy's two bodies) that shift pointed along the element
+  /// form's error (cosine 0.56 to 1.00); with it the region was at its level on SfePy's bodies and
+  /// over-wide below 95 % on the phantom, without it biased on both (BENCHMARKS.md, "The element
+  /// form's own error in the tumour's region"). Not in the linearised region (the reference costs
   /// 2 to 3 registrations). false: left out.
   bool discretisation = true;
 

@@ -36,8 +36,10 @@
 // pose (except through an estimated E's sd), the landmark step's influence on where the surface step ends
 // (it is a start, not an input, of the equilibrium), E's estimate compensating a wrong
 // Poisson's ratio unless the landmark fit it came from is given (LandmarkStiffnessFit; the
-// pipeline gives it), and model error beyond these inputs. Sampling (RegistrationEngine::
-// sample_uncertainty) draws every source, the landmarks included.
+// pipeline gives it), the element form's discretisation error, and model error beyond these
+// inputs. Sampling (RegistrationEngine::sample_uncertainty) draws every source, the landmarks
+// included, and takes the element form's discretisation error from a nodal reference
+// (UncertaintySources::discretisation).
 //
 // Experimental, off by default: not yet validated (BENCHMARKS.md, issue 14). The machinery is
 // exact: against re-solves of the energy it differentiates (held projections) it agrees within
@@ -246,9 +248,10 @@ double percentile_95(std::vector<double> distances);
 /// The distances from the nominal point of sampled offsets (sample minus nominal) with the
 /// element form's estimated discretisation error: each offset moved by `shift`, the nodal
 /// reference's displacement from the nominal (|o + shift|). The shift is taken as the bias it
-/// was measured to be, not as a spread: on a truth our elements did not make it pointed along the
+/// was measured to be, not as a spread: on truth our elements did not make it pointed along the
 /// element form's error (cosine 0.56 to 1.00); taken as Gaussian along itself instead, the
-/// region held 84 % at its 68 % level (BENCHMARKS.md, issue 14). A zero shift gives the norms.
+/// region held 84 % at its 68 % level on the phantom's quadratic truth (BENCHMARKS.md, "The
+/// element form's own error in the tumour's region"). A zero shift gives the norms.
 std::vector<double> sampled_distances(const std::vector<Vec3>& offsets, const Vec3& shift);
 
 /// The two horizontal axes the gravity-direction source tilts about (both the linearisation and
