@@ -94,6 +94,18 @@ void expect_e_and_tilt_match(const std::string& name, const TumourUncertainty& u
   EXPECT_LT((u.d_gravity_tilt[0] - fd_g).norm(), 0.03 * fd_g.norm()) << name;
 }
 
+/// Writes `nominal` with `sampled` into a new folder (returned through `dir`), as btr_register
+/// does, and parses its report.json.
+nlohmann::json sampled_report(RegistrationEngine& engine, const RegistrationOptions& o, RegistrationResult nominal,
+                              const SampledUncertainty& sampled, std::string& dir) {
+  nominal.sampled_uncertainty = sampled;
+  const PreparedScene& prep = engine.prepare(o);
+  dir = btr::test::temp_dir();
+  write_registration_outputs(dir, prep.scene, prep.model, nominal, 0);
+  std::ifstream report(dir + "/report.json");
+  return nlohmann::json::parse(report);
+}
+
 }  // namespace
 
 TEST(Uncertainty, VolumeCentroidJacobianMatchesFiniteDifferences) {
@@ -685,13 +697,9 @@ TEST(Uncertainty, SamplingIsReproducibleAndWithoutSourcesHasNoSpread) {
   // The outputs: each tumour's margin shell, its vertices that far from the registered ones,
   // and the report's figures.
   {
-    RegistrationResult with = nominal;
-    with.sampled_uncertainty = a;
+    std::string d;
+    const nlohmann::json j = sampled_report(engine, o, nominal, a, d);
     const PreparedScene& prep = engine.prepare(o);
-    const std::string d = btr::test::temp_dir();
-    write_registration_outputs(d, prep.scene, prep.model, with, 0);
-    std::ifstream report(d + "/report.json");
-    const nlohmann::json j = nlohmann::json::parse(report);
     EXPECT_DOUBLE_EQ(j.at("uncertainty_sources").at("landmark_sd_mm").get<double>(), 1.5);  // the defaults, stated
     EXPECT_DOUBLE_EQ(j.at("uncertainty_sources").at("youngs_modulus_range_Pa")[1].get<double>(), 3000);
     for (size_t i = 0; i < a.tumours.size(); ++i) {
@@ -798,13 +806,8 @@ TEST(Uncertainty, SamplingTakesTheNodalReferencesShiftAsTheElementFormsDiscretis
   EXPECT_FALSE(c.discretisation_estimated);
   EXPECT_NE(c.note.find("discretisation not estimated: the registration used the nodal volume form"), std::string::npos) << c.note;
   // The report states both radii, the shift and the source.
-  RegistrationResult with = nominal;
-  with.sampled_uncertainty = a;
-  const PreparedScene& prep = engine.prepare(o);
-  const std::string d = btr::test::temp_dir();
-  write_registration_outputs(d, prep.scene, prep.model, with, 0);
-  std::ifstream report(d + "/report.json");
-  const nlohmann::json j = nlohmann::json::parse(report);
+  std::string d;
+  const nlohmann::json j = sampled_report(engine, o, nominal, a, d);
   EXPECT_TRUE(j.at("uncertainty_sampled").at("discretisation_estimated").get<bool>());
   const auto& t0 = j.at("tumours")[0].at("uncertainty_sampled");
   EXPECT_NEAR(t0.at("radius_95_sources_mm").get<double>(), a.tumours[0].radius_95_sources * 1e3, 1e-9);
