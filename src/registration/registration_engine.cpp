@@ -118,8 +118,8 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
 const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt) { return entry(opt).prepared; }
 
 RegistrationEngine::Entry& RegistrationEngine::twin_entry(Entry& e, VolumeForm form) {
-  if (e.prepared.scene.material.volume_form == form) return e;
-  if (e.twin) return *e.twin;
+  if (e.prepared.model.volume_form == form) return e;  // as resolved (auto: by Poisson's ratio)
+  if (e.twin) return *e.twin;  // the one other form
   const auto t0 = std::chrono::steady_clock::now();
   auto f = std::make_unique<Entry>();
   PreparedScene& p = f->prepared;

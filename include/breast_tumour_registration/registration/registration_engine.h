@@ -99,7 +99,7 @@ class RegistrationEngine {
     std::unique_ptr<Entry> twin;
   };
   Entry& entry(const RegistrationOptions& opt);
-  /// e's twin with the volume form `form` (e's own is the other), prepared on first use
+  /// e itself where its model resolved to `form`, else its twin with that form, prepared on first use
   Entry& twin_entry(Entry& e, VolumeForm form);
   /// The model's discretisation error as sampling takes it (UncertaintySources::discretisation):
   /// the nominal inputs (`scene`, on e's mesh) registered again with the nodal volume form; none,
