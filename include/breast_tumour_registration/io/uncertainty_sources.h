@@ -43,7 +43,7 @@ struct UncertaintySources {
   /// form's error (cosine 0.56 to 1.00); with it the region was at its level on SfePy's bodies and
   /// over-wide below 95 % on the phantom, without it biased on both (BENCHMARKS.md, "The element
   /// form's own error in the tumour's region"). Not in the linearised region (the reference costs
-  /// 2 to 3 registrations). false: left out.
+  /// 2 to 4 registrations). false: left out.
   bool discretisation = true;
 
   bool samples_youngs_modulus() const { return youngs_modulus_range[1] > 0; }
