@@ -1,6 +1,5 @@
 // Where the tumour may be (issue 14): the linearised centroid uncertainty against full re-solves.
 #include <algorithm>
-#include <numeric>
 #include <cmath>
 #include <filesystem>
 #include <optional>
