@@ -70,6 +70,14 @@ std::string without_figures(const std::string& reason) {
   return out;
 }
 
+/// The steps of `r` that did not converge, as "name: stop reason", joined by "; ".
+std::string unconverged_steps(const RegistrationResult& r) {
+  std::string out;
+  for (const auto& rep : r.reports)
+    if (!rep.converged) out += (out.empty() ? "" : "; ") + rep.name + ": " + rep.stop_reason;
+  return out;
+}
+
 }  // namespace
 
 RegistrationEngine::RegistrationEngine(Scene scene, UnloadOptions unload) : scene_(std::move(scene)), unload_(unload) {}
@@ -141,8 +149,7 @@ RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const 
   // The nodal form did not converge (on coarse soft meshes it folds where the element form's
   // locking holds the mesh together): the element form on the same mesh, from the start.
   RegistrationResult::VolumeFormFallback why;
-  for (const auto& rep : r.reports)
-    if (!rep.converged) why.nodal_stop += (why.nodal_stop.empty() ? "" : "; ") + rep.name + ": " + rep.stop_reason;
+  why.nodal_stop = unconverged_steps(r);
   why.nodal_seconds = r.seconds;
   const bool first = !e.twin;
   Entry& f = twin_entry(e, VolumeForm::Element);
@@ -377,10 +384,7 @@ std::optional<RegistrationResult> RegistrationEngine::discretisation_reference(E
   try {
     RegistrationResult r = run_registration(s, n.prepared.model, o, {}, &n.solvers);
     if (!r.converged) {
-      std::string why;
-      for (const auto& rep : r.reports)
-        if (!rep.converged) why += (why.empty() ? "" : "; ") + rep.name + ": " + without_figures(rep.stop_reason);
-      notes.push_back("discretisation not estimated: the nodal reference did not converge (" + why + ")");
+      notes.push_back("discretisation not estimated: the nodal reference did not converge (" + unconverged_steps(r) + ")");
       return std::nullopt;
     }
     if (r.tumours.size() != nominal.tumours.size()) throw SolverError("the nodal reference has another tumour count");
