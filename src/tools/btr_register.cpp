@@ -169,12 +169,15 @@ int main(int argc, char** argv) {
                   r.uncertainty_note.c_str());
     if (r.sampled_uncertainty) {
       const SampledUncertainty& su = *r.sampled_uncertainty;
-      for (size_t i = 0; i < su.tumours.size() && i < r.tumours.size(); ++i)
-        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm; sources alone %.2f mm, discretisation %.2f mm), "
+      for (size_t i = 0; i < su.tumours.size() && i < r.tumours.size(); ++i) {
+        char discretisation[48] = "not estimated";  // the note below says why
+        if (su.discretisation_estimated)
+          std::snprintf(discretisation, sizeof discretisation, "%.2f mm", su.tumours[i].discretisation.norm() * 1e3);
+        std::printf("[sampled ] %-8s 95 %% radius %.2f mm (linear %.2f mm; sources alone %.2f mm, discretisation %s), "
                     "mean shift %.2f mm, margin shell up to %.2f mm%s\n",
                     r.tumours[i].name.c_str(), su.tumours[i].radius_95 * 1e3,
                     r.tumours[i].uncertainty ? r.tumours[i].uncertainty->radius_95 * 1e3 : 0.0,
-                    su.tumours[i].radius_95_sources * 1e3, su.tumours[i].discretisation.norm() * 1e3,
+                    su.tumours[i].radius_95_sources * 1e3, discretisation,
                     su.tumours[i].mean_shift.norm() * 1e3,
                     su.tumours[i].vertex_radius_95.empty()
                         ? 0.0
@@ -183,10 +186,12 @@ int main(int argc, char** argv) {
                                                          ? "; holds the true centroid"
                                                          : "; the true centroid lies outside")
                                                   : "");
-      std::printf("[sampled ] %d samples (%d not converged, %d failed), %.3f s each, the discretisation's nodal reference "
-                  "%.3f s%s%s\n",
-                  su.samples, su.not_converged, su.failed, su.seconds_per_sample, su.discretisation_seconds,
-                  su.note.empty() ? "" : ": ", su.note.c_str());
+      }
+      char reference[64] = "";
+      if (su.discretisation_estimated)
+        std::snprintf(reference, sizeof reference, ", the discretisation's nodal reference %.3f s", su.discretisation_seconds);
+      std::printf("[sampled ] %d samples (%d not converged, %d failed), %.3f s each%s%s%s\n", su.samples, su.not_converged,
+                  su.failed, su.seconds_per_sample, reference, su.note.empty() ? "" : ": ", su.note.c_str());
     }
     const auto files = write_registration_outputs(out_dir, sim, model, r, prepare);
     std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "
