@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
     std::ofstream csv(out_path);
     if (!csv) throw InputError("cannot write '" + out_path + "'");
     csv << "knob,value,base_preset,cell_size_mm,tetrahedra,prepare_seconds,seconds_median,worst_error_mm,mean_error_mm,"
-           "converged\n";
+           "converged,volume_form\n";
     // One engine per simulation mesh (as the node keeps it): prepared once, solved repeatedly.
     std::map<double, std::unique_ptr<RegistrationEngine>> engines;
     std::map<double, double> prepare_seconds;
@@ -134,11 +134,13 @@ int main(int argc, char** argv) {
       }
       csv << p.knob << ',' << p.value << ',' << p.base << ',' << p.cell_mm << ',' << m.rest.T.rows() << ','
           << prepare_seconds[p.cell_mm] << ',' << median(secs) << ',' << worst << ',' << mean << ','
-          << (r.converged ? 1 : 0) << '\n';
+          << (r.converged ? 1 : 0) << ','
+          << (r.volume_form_fallback ? "element_fallback" : to_string(r.volume_form)) << '\n';
       csv.flush();
       std::printf("%-18s %-10s %-8s cell %4.1f mm %6ld tets: %.3f s, worst %.3f mm, mean %.3f mm%s\n", p.knob.c_str(),
                   p.value.c_str(), p.base.c_str(), p.cell_mm, static_cast<long>(m.rest.T.rows()), median(secs), worst, mean,
                   r.converged ? "" : " (not converged)");
+      if (r.volume_form_fallback) std::printf("  (the nodal form did not converge: the element form's result)\n");
       std::fflush(stdout);
     }
     return 0;
