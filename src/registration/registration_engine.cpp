@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/fem/volume_form.h"
 #include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
@@ -93,16 +94,26 @@ RegistrationEngine::RegistrationEngine(Scene simulated, RegistrationModel model,
 
 RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& opt) {
   if (adopted_) return *entries_.begin()->second;
+  // The preset's nodal form where the scene leaves the form to `auto` and plans the unloaded
+  // shape (an explicit element or nodal is the scene's choice); else the scene's form as
+  // resolved (auto: by Poisson's ratio). RegistrationOptions::volume_form says why.
+  const bool preset_form = takes_preset_volume_form(scene_, opt);
+  const VolumeForm form =
+      preset_form ? VolumeForm::Nodal : resolve_volume_form(scene_.material.volume_form, scene_.material.poisson_ratio);
+  RegistrationOptions mesh_opt = opt;  // with the mesh the preset simulates its nodal form on
+  if (preset_form && opt.nodal_simulation_cell_size > 0) mesh_opt.simulation_cell_size = opt.nodal_simulation_cell_size;
   // The key is the mesh the call simulates: the size a prone surface is meshed at, the preset's
-  // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given.
+  // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given. The
+  // first call on a mesh prepares it with its form; the other form is the entry's twin.
   const bool unmeshed = scene_.prone.T.rows() == 0 && scene_.prone_source;
   double key = 0;
   if (unmeshed)
-    key = scene_.prone_source->cell_size.value_or(opt.simulation_cell_size > 0 ? opt.simulation_cell_size : kDefaultCellSize);
-  else if (needs_simulation_mesh(scene_, opt))
-    key = opt.simulation_cell_size;
+    key = scene_.prone_source->cell_size.value_or(mesh_opt.simulation_cell_size > 0 ? mesh_opt.simulation_cell_size
+                                                                                   : kDefaultCellSize);
+  else if (needs_simulation_mesh(scene_, mesh_opt))
+    key = mesh_opt.simulation_cell_size;
   auto it = entries_.find(key);
-  if (it != entries_.end()) return *it->second;
+  if (it != entries_.end()) return twin_entry(*it->second, form);
 
   const auto t0 = std::chrono::steady_clock::now();
   auto e = std::make_unique<Entry>();
@@ -117,6 +128,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
   } else {
     p.scene = scene_;
   }
+  if (preset_form) p.scene.material.volume_form = form;
   p.mesh_seconds = key > 0 ? p.scene.tetrahedralize_seconds : 0;
   p.model = prepare_model(p.scene, p.warnings, unload_, &e->solvers);
   p.prepare_seconds = since(t0);
@@ -128,6 +140,7 @@ const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt)
 RegistrationEngine::Entry& RegistrationEngine::twin_entry(Entry& e, VolumeForm form) {
   if (e.prepared.model.volume_form == form) return e;  // as resolved (auto: by Poisson's ratio)
   if (e.twin) return *e.twin;  // the one other form
+  if (e.twin_of) return *e.twin_of;  // e is the twin
   const auto t0 = std::chrono::steady_clock::now();
   auto f = std::make_unique<Entry>();
   PreparedScene& p = f->prepared;
@@ -137,6 +150,7 @@ RegistrationEngine::Entry& RegistrationEngine::twin_entry(Entry& e, VolumeForm f
   p.mesh_seconds = e.prepared.mesh_seconds;
   p.model = prepare_model(p.scene, p.warnings, unload_, &f->solvers);
   p.prepare_seconds = since(t0);
+  f->twin_of = &e;
   e.twin = std::move(f);
   return *e.twin;
 }
@@ -151,7 +165,7 @@ RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const 
   RegistrationResult::VolumeFormFallback why;
   why.nodal_stop = unconverged_steps(r);
   why.nodal_seconds = r.seconds;
-  const bool first = !e.twin;
+  const bool first = !e.twin && !e.twin_of;
   Entry& f = twin_entry(e, VolumeForm::Element);
   if (first) why.prepare_seconds = f.prepared.prepare_seconds;
   Scene s = supine;

@@ -64,11 +64,13 @@ struct Preset {
   int subspace_handles;
   double gradient_rel_tolerance;  ///< landmark and surface Newton
   double projection_tolerance;    ///< [m] surface step, on the distance to the fixed point
+  VolumeForm volume_form;         ///< where the scene says auto and unloads (RegistrationOptions::volume_form)
+  double nodal_simulation_cell_size;  ///< [m] the mesh of that nodal form
 };
 constexpr Preset kPresets[] = {
-    {"fast", 0.009, 30, 1e-3, 2e-4},
-    {"balanced", 0.007, 60, 1e-4, 1e-4},
-    {"accurate", 0.004, 60, 1e-6, 1e-5},
+    {"fast", 0.009, 30, 1e-3, 2e-4, VolumeForm::Auto, 0},
+    {"balanced", 0.007, 60, 1e-4, 1e-4, VolumeForm::Nodal, 0.009},
+    {"accurate", 0.004, 60, 1e-6, 1e-5, VolumeForm::Auto, 0},
 };
 
 }  // namespace
@@ -92,7 +94,14 @@ RegistrationOptions preset_options(const std::string& name) {
   o.landmark.newton.gradient_rel_tolerance = p->gradient_rel_tolerance;
   o.surface.newton.gradient_rel_tolerance = p->gradient_rel_tolerance;
   o.surface.projection_tolerance = p->projection_tolerance;
+  o.volume_form = p->volume_form;
+  o.nodal_simulation_cell_size = p->nodal_simulation_cell_size;
   return o;
+}
+
+bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt) {
+  return scene.material.volume_form == VolumeForm::Auto && opt.volume_form == VolumeForm::Nodal &&
+         scene.prone_gravity.has_value();
 }
 
 std::string PlannedSteps::describe() const {

@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
     }
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
     RegistrationOptions opt = preset_options(scene.preset);
-    if (cell_mm >= 0) opt.simulation_cell_size = cell_mm * 1e-3;
+    if (cell_mm >= 0) opt.simulation_cell_size = opt.nodal_simulation_cell_size = cell_mm * 1e-3;  // whatever the form
     opt.uncertainty.enabled = uncertainty != "none";
     opt.uncertainty.sources = scene.uncertainty;  // the defaults unless the scene's `uncertainty:` says otherwise
     // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh (the engine meshes once).
@@ -91,9 +91,13 @@ int main(int argc, char** argv) {
                   sim.prone_source ? "" : "; --cell-size 0 keeps the scene's mesh");
     const PlannedSteps plan = plan_steps(sim);
     const double prepare = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    std::printf("[register] %s: %ld vertices, %ld tetrahedra%s; steps: %s; preset %s\n", scene_path.c_str(),
-                static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows()),
-                sim.tetrahedralized ? " (tetrahedralized)" : "", plan.describe().c_str(), opt.preset.c_str());
+    std::printf("[register] %s: %ld vertices, %ld tetrahedra%s; steps: %s; preset %s, %s volume form%s\n",
+                scene_path.c_str(), static_cast<long>(model.rest.V.rows()), static_cast<long>(model.rest.T.rows()),
+                sim.tetrahedralized ? " (tetrahedralized)" : "", plan.describe().c_str(), opt.preset.c_str(),
+                to_string(model.volume_form),
+                takes_preset_volume_form(engine.scene(), opt)
+                    ? " (the preset's for a scene that unloads; material.volume_form: element keeps the element form)"
+                    : "");
     if (model.materials.size() > 1) {
       std::string mats;
       for (size_t i = 0; i < model.materials.size(); ++i)

@@ -96,6 +96,60 @@ TEST(Engine, AnAdoptedModelIsSolvedAsGivenWhateverThePresetsMesh) {
   EXPECT_EQ(largest_difference(engine.solve(coarse).x, fresh(s, coarse).x), 0.0);
 }
 
+// A preset may ask for the nodal volume form (RegistrationOptions::volume_form; balanced does).
+// The engine takes it where the scene's material leaves the form to `auto` and the scene plans
+// the unloaded shape, on the preset's mesh for that form, prepared once and kept beside the
+// element form's; a form the scene states, or a scene that keeps the prone shape as its rest
+// shape, keeps the element form.
+TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto) {
+  Scene s = btr::test::coarse_phantom_scene();
+  ASSERT_EQ(s.material.volume_form, VolumeForm::Auto);
+  ASSERT_EQ(resolve_volume_form(s.material.volume_form, s.material.poisson_ratio), VolumeForm::Element);
+  s.prone_gravity = Vec3(0, 0, 9.81);
+  const RegistrationOptions balanced = preset_options("balanced");
+  ASSERT_EQ(balanced.volume_form, VolumeForm::Nodal);
+  RegistrationOptions by_poisson = balanced;
+  by_poisson.volume_form = VolumeForm::Auto;
+  RegistrationOptions nodal = balanced;
+  nodal.nodal_simulation_cell_size = 0.025;  // coarser than this 12 mm mesh: re-tetrahedralized
+  EXPECT_TRUE(takes_preset_volume_form(s, nodal));
+
+  RegistrationEngine engine(s);
+  const RegistrationResult r = engine.solve(nodal);
+  EXPECT_TRUE(r.converged) << btr::test::step_stops(r);
+  EXPECT_EQ(r.volume_form, VolumeForm::Nodal);
+  const PreparedScene& pn = engine.prepare(nodal);
+  EXPECT_NE(pn.mesh_note.find("re-tetrahedralized"), std::string::npos) << pn.mesh_note;
+  Scene stated = with_simulation_mesh(s, 0.025);
+  stated.material.volume_form = VolumeForm::Nodal;
+  EXPECT_EQ(largest_difference(r.x, fresh(stated, nodal).x), 0.0);  // as if the scene had said nodal, on that mesh
+
+  const PreparedScene& pe = engine.prepare(by_poisson);
+  EXPECT_NE(&pn, &pe);
+  EXPECT_EQ(pn.model.volume_form, VolumeForm::Nodal);
+  EXPECT_EQ(pe.model.volume_form, VolumeForm::Element);
+  EXPECT_EQ(pe.model.rest.T.rows(), s.prone.T.rows());  // the element form on the scene's mesh
+  EXPECT_LT(pn.model.rest.T.rows(), pe.model.rest.T.rows());
+  EXPECT_EQ(&engine.prepare(nodal), &pn);  // each kept
+  EXPECT_EQ(&engine.prepare(by_poisson), &pe);
+  const RegistrationResult e = engine.solve(by_poisson);
+  EXPECT_EQ(e.volume_form, VolumeForm::Element);
+  EXPECT_EQ(largest_difference(e.x, fresh(s, by_poisson).x), 0.0);
+  // On one mesh the two forms are one entry and its twin.
+  const PreparedScene& own = engine.prepare(balanced);
+  EXPECT_EQ(own.model.volume_form, VolumeForm::Nodal);
+  EXPECT_EQ(own.model.rest.T.rows(), s.prone.T.rows());
+
+  Scene told = s;  // the scene's explicit form wins
+  told.material.volume_form = VolumeForm::Element;
+  EXPECT_FALSE(takes_preset_volume_form(told, balanced));
+  EXPECT_EQ(RegistrationEngine(told).prepare(balanced).model.volume_form, VolumeForm::Element);
+  Scene prone_rest = s;  // the thesis's model: the prone shape as the rest shape
+  prone_rest.prone_gravity.reset();
+  EXPECT_FALSE(takes_preset_volume_form(prone_rest, balanced));
+  EXPECT_EQ(RegistrationEngine(prone_rest).prepare(balanced).model.volume_form, VolumeForm::Element);
+}
+
 // The nodal volume form folds coarse soft meshes where the element form's locking holds them
 // together (BENCHMARKS.md, "The nodal volume term as the default"). Where a nodal registration
 // ends not converged the engine registers again with the element form, returns that result and

@@ -20,7 +20,10 @@ enum class VolumeForm { Auto, Element, Nodal };
 /// form), although from 1000 Pa up and with the full method it is the nearer model on both
 /// independent bodies. `material.volume_form: nodal` chooses it at any nu (BENCHMARKS.md, "The
 /// nodal volume term's cost"); `material.nodal_element_share` converges some of those folding
-/// runs at a cost in accuracy (BENCHMARKS.md, "The nodal form with an element share").
+/// runs at a cost in accuracy (BENCHMARKS.md, "The nodal form with an element share"). Since
+/// 2026-12-06 a preset may take the nodal form where a scene leaves it to auto and unloads
+/// (RegistrationOptions::volume_form; the balanced preset does, at 9 mm: BENCHMARKS.md, "The
+/// presets' front with the volume form").
 constexpr double kNodalVolumeFromPoisson = 0.495;
 VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio);
 /// Parses "auto", "element" or "nodal"; InputError otherwise.

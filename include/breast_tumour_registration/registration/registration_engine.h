@@ -97,9 +97,15 @@ class RegistrationEngine {
     /// made on first use: the element form where a nodal registration falls back to it, the
     /// nodal form where sampling estimates the element form's discretisation error
     std::unique_ptr<Entry> twin;
+    Entry* twin_of = nullptr;  ///< the entry this one is the twin of
   };
+  /// The entry a call simulates on: opt's simulation mesh, with the preset's nodal form where the
+  /// scene's volume form is auto (RegistrationOptions::volume_form), else the scene's form as
+  /// resolved; prepared on first use (the first form asked for on a mesh is its entry, the other
+  /// that entry's twin)
   Entry& entry(const RegistrationOptions& opt);
-  /// e itself where its model resolved to `form`, else its twin with that form, prepared on first use
+  /// e itself where its model resolved to `form`, else its twin with that form (or the entry e is
+  /// the twin of), prepared on first use
   Entry& twin_entry(Entry& e, VolumeForm form);
   /// The model's discretisation error as sampling takes it (UncertaintySources::discretisation):
   /// the nominal inputs (`scene`, on e's mesh) registered again with the nodal volume form; none,

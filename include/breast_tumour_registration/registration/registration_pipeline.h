@@ -29,6 +29,16 @@ struct RegistrationOptions {
   /// > 0: simulate on the prone model re-tetrahedralized at this cell size [m] when the
   /// scene's mesh is finer (see simulation_scene); 0: the scene's mesh as given.
   double simulation_cell_size = 0;
+  /// The preset's volume form, taken by RegistrationEngine where the scene's material.volume_form
+  /// is `auto` and the scene plans the unloaded shape (prone_gravity): Nodal registers such a scene
+  /// with the nodal form, on the mesh nodal_simulation_cell_size gives. An explicit element or
+  /// nodal in the scene wins; Auto leaves the form to Poisson's ratio (kNodalVolumeFromPoisson).
+  /// Only unloading scenes: with the prone shape as the rest shape on soft tissue the nodal form
+  /// folds the mesh and ends farther off (BENCHMARKS.md, "The nodal volume term as the default").
+  VolumeForm volume_form = VolumeForm::Auto;
+  /// > 0: the simulation cell size [m] where the preset's nodal form is taken (the nodal form is
+  /// the costlier per tetrahedron and locks less, so its point on the front is a coarser mesh)
+  double nodal_simulation_cell_size = 0;
   /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
   /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
   std::optional<Rigid> known_supine_to_model;
@@ -54,6 +64,11 @@ struct RegistrationOptions {
   /// The tumours' linearised uncertainty (tumour_uncertainty.h), when enabled and the surface step ran.
   UncertaintyOptions uncertainty;
 };
+
+/// Whether a registration of `scene` with `opt` takes the preset's nodal volume form
+/// (RegistrationOptions::volume_form): the scene's form is auto, it plans the unloaded shape, and
+/// the preset asks for the nodal form.
+bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt);
 
 /// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
 /// measured speed and accuracy of each). Throws InputError for another name.
