@@ -303,9 +303,6 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           scene.material.nodal_element_share = opt.method_nodal_element_share;
           scene.material.unload_element_order = opt.method_unload_element_order;
           scene.nodal_fallback = opt.method_nodal_fallback;
-          // auto: the preset's nodal form where the engine would take it (the suite's adopted
-          // models are prepared here, not by the engine), on the suite's own mesh
-          if (takes_preset_volume_form(scene, preset)) scene.material.volume_form = VolumeForm::Nodal;
           if (opt.simulation_cell_size > 0) scene = with_simulation_mesh(scene, opt.simulation_cell_size);
           std::vector<std::string> warnings;
           // The unloaded shape depends on the configuration and the method's material only:

@@ -51,8 +51,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   std::string volume_form = "auto";
   app.add_option("--volume-form", volume_form,
-                 "the method's volume term: auto (element below nu = 0.495), element or nodal (no locking, slower); "
-                 "the generated truth keeps its own")
+                 "the method's volume term: auto (element below nu = 0.495; the suite simulates its own meshes, so it does "
+                 "not take the balanced preset's nodal form on 9 mm, which btr_register does where a scene unloads), "
+                 "element or nodal (no locking, slower); the generated truth keeps its own")
       ->check(CLI::IsMember({"auto", "element", "nodal"}))
       ->capture_default_str();
   ElementOrder unload_elements = ElementOrder::Linear, truth_elements = ElementOrder::Linear;
