@@ -43,9 +43,11 @@ class RegistrationEngine {
   /// unloaded shape is shared between runs); every call simulates on it, whatever the preset's mesh.
   RegistrationEngine(Scene simulated, RegistrationModel model, std::vector<std::string> warnings = {});
 
-  /// The prone side for opt's simulation mesh: a prone surface is tetrahedralized at its
-  /// prone.cell_size_mm, else the preset's size; a finer scene mesh is re-tetrahedralized at the
-  /// preset's size (simulation_scene); the model is prepared. Done on first use and kept.
+  /// The prone side for opt's simulation mesh and volume form: a prone surface is tetrahedralized
+  /// at its prone.cell_size_mm, else the preset's size; a finer scene mesh is re-tetrahedralized at
+  /// the preset's size (simulation_scene); the model is prepared with the scene's volume form, or
+  /// the preset's nodal form where the scene unloads and says auto (takes_preset_volume_form, on
+  /// the preset's mesh for it). Done on first use and kept.
   /// InputError / SolverError as load_scene, mesh_prone and prepare_model.
   const PreparedScene& prepare(const RegistrationOptions& opt);
 
@@ -100,9 +102,10 @@ class RegistrationEngine {
     Entry* twin_of = nullptr;  ///< the entry this one is the twin of
   };
   /// The entry a call simulates on: opt's simulation mesh, with the preset's nodal form where the
-  /// scene's volume form is auto (RegistrationOptions::volume_form), else the scene's form as
-  /// resolved; prepared on first use (the first form asked for on a mesh is its entry, the other
-  /// that entry's twin)
+  /// scene's volume form is auto and the scene unloads (takes_preset_volume_form; on the mesh
+  /// RegistrationOptions::nodal_simulation_cell_size gives), else the scene's form as resolved;
+  /// prepared on first use (the first form asked for on a mesh is its entry, the other that
+  /// entry's twin)
   Entry& entry(const RegistrationOptions& opt);
   /// e itself where its model resolved to `form`, else its twin with that form (or the entry e is
   /// the twin of), prepared on first use
