@@ -155,26 +155,49 @@ RegistrationEngine::Entry& RegistrationEngine::twin_entry(Entry& e, VolumeForm f
   return *e.twin;
 }
 
-RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const RegistrationOptions& opt,
+RegistrationEngine::Entry& RegistrationEngine::fallback_entry(Entry& e, const RegistrationOptions& opt) {
+  if (!adopted_ && takes_preset_volume_form(scene_, opt)) {
+    // The preset chose the nodal form (on its own mesh): the fallback is the call without that
+    // choice, the element form on the preset's element mesh, never a coarser element model.
+    RegistrationOptions own = opt;
+    own.volume_form = VolumeForm::Auto;
+    return twin_entry(entry(own), VolumeForm::Element);
+  }
+  return twin_entry(e, VolumeForm::Element);
+}
+
+int RegistrationEngine::prepared_entries() const {
+  int n = 0;
+  for (const auto& [k, e] : entries_) n += 1 + (e->twin ? 1 : 0);
+  return n;
+}
+
+RegistrationResult RegistrationEngine::run(Entry& e, const SupineFor& supine_for, const RegistrationOptions& opt,
                                            const StepCallback& callback) {
-  RegistrationResult r = run_registration(supine, e.prepared.model, opt, callback, &e.solvers);
+  RegistrationOptions o = opt;
+  const Scene supine = supine_for(e, o);
+  RegistrationResult r = run_registration(supine, e.prepared.model, o, callback, &e.solvers);
   r.warnings.insert(r.warnings.begin(), e.prepared.warnings.begin(), e.prepared.warnings.end());
   if (r.converged || r.volume_form != VolumeForm::Nodal || !supine.nodal_fallback) return r;
   // The nodal form did not converge (on coarse soft meshes it folds where the element form's
-  // locking holds the mesh together): the element form on the same mesh, from the start.
+  // locking holds the mesh together): the element form, from the start.
   RegistrationResult::VolumeFormFallback why;
   why.nodal_stop = unconverged_steps(r);
   why.nodal_seconds = r.seconds;
-  const bool first = !e.twin && !e.twin_of;
-  Entry& f = twin_entry(e, VolumeForm::Element);
-  if (first) why.prepare_seconds = f.prepared.prepare_seconds;
-  Scene s = supine;
+  const int before = prepared_entries();
+  Entry& f = fallback_entry(e, opt);
+  if (prepared_entries() > before) why.prepare_seconds = f.prepared.prepare_seconds;
+  const auto root = [](const Entry& x) { return x.twin_of ? x.twin_of : &x; };
+  if (root(f) != root(e)) why.mesh_note = f.prepared.mesh_note.empty() ? "the scene's mesh" : f.prepared.mesh_note;
+  RegistrationOptions fo = opt;
+  Scene s = supine_for(f, fo);
   s.material.volume_form = VolumeForm::Element;
-  RegistrationResult fr = run_registration(s, f.prepared.model, opt, callback, &f.solvers);
+  RegistrationResult fr = run_registration(s, f.prepared.model, fo, callback, &f.solvers);
   fr.warnings.insert(fr.warnings.begin(), f.prepared.warnings.begin(), f.prepared.warnings.end());
   fr.warnings.push_back("the nodal volume form did not converge (" + why.nodal_stop +
-                        "); registered again with the element form, which " +
-                        (fr.converged ? "converged" : "did not converge either") +
+                        "); registered again with the element form" +
+                        (why.mesh_note.empty() ? std::string() : " on the preset's mesh for it (" + why.mesh_note + ")") +
+                        ", which " + (fr.converged ? "converged" : "did not converge either") +
                         ": this is its result (material.nodal_fallback: false keeps the nodal one)");
   fr.seconds += why.nodal_seconds + why.prepare_seconds;
   fr.volume_form_fallback = std::move(why);
@@ -182,25 +205,36 @@ RegistrationResult RegistrationEngine::run(Entry& e, const Scene& supine, const 
 }
 
 RegistrationResult RegistrationEngine::solve(const RegistrationOptions& opt, const StepCallback& callback) {
-  Entry& e = entry(opt);
-  Scene s = e.prepared.scene;
-  s.preset = opt.preset;
-  return run(e, s, opt, callback);
+  return run(
+      entry(opt),
+      [](const Entry& x, const RegistrationOptions& o) {
+        Scene s = x.prepared.scene;
+        s.preset = o.preset;
+        return s;
+      },
+      opt, callback);
 }
 
 RegistrationResult RegistrationEngine::solve(const Scene& supine, const RegistrationOptions& opt,
                                              const StepCallback& callback) {
-  Entry& e = entry(opt);
-  Scene s = with_supine_side(e.prepared.scene, supine);
-  s.preset = opt.preset;
-  return run(e, s, opt, callback);
+  return run(
+      entry(opt),
+      [&supine](const Entry& x, const RegistrationOptions& o) {
+        Scene s = with_supine_side(x.prepared.scene, supine);
+        s.preset = o.preset;
+        return s;
+      },
+      opt, callback);
 }
 
 RegistrationResult RegistrationEngine::solve_live(const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions opt,
                                                   const StepCallback& callback) {
-  Entry& e = entry(opt);
-  const Scene s = live_call(e, scan, live, opt);
-  return run(e, s, opt, callback);
+  return run(
+      entry(opt), [&](const Entry& x, RegistrationOptions& o) { return live_call(x, scan, live, o); }, opt, callback);
+}
+
+const PreparedScene& RegistrationEngine::prepared_for(const RegistrationOptions& opt, const RegistrationResult& r) {
+  return nominal_entry(opt, r).prepared;
 }
 
 Scene RegistrationEngine::live_call(const Entry& e, const LiveScan& scan, const LiveSceneOptions& live,
@@ -217,7 +251,7 @@ Scene RegistrationEngine::live_call(const Entry& e, const LiveScan& scan, const 
 
 SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOptions& opt, const UncertaintyOptions& sources,
                                                          int samples, unsigned seed, const RegistrationResult& nominal) {
-  Entry& e = nominal_entry(entry(opt), nominal);
+  Entry& e = nominal_entry(opt, nominal);
   Scene s = e.prepared.scene;
   s.preset = opt.preset;
   return sample(e, s, opt, sources, samples, seed, nominal);
@@ -226,7 +260,7 @@ SampledUncertainty RegistrationEngine::sample_uncertainty(const RegistrationOpti
 SampledUncertainty RegistrationEngine::sample_uncertainty_live(const LiveScan& scan, const LiveSceneOptions& live,
                                                               RegistrationOptions opt, const UncertaintyOptions& sources,
                                                               int samples, unsigned seed, const RegistrationResult& nominal) {
-  Entry& e = nominal_entry(entry(opt), nominal);
+  Entry& e = nominal_entry(opt, nominal);
   const Scene s = live_call(e, scan, live, opt);
   return sample(e, s, opt, sources, samples, seed, nominal);
 }
@@ -411,8 +445,10 @@ std::optional<RegistrationResult> RegistrationEngine::discretisation_reference(E
   }
 }
 
-RegistrationEngine::Entry& RegistrationEngine::nominal_entry(Entry& e, const RegistrationResult& nominal) {
-  return nominal.volume_form_fallback ? twin_entry(e, VolumeForm::Element) : e;
+RegistrationEngine::Entry& RegistrationEngine::nominal_entry(const RegistrationOptions& opt,
+                                                             const RegistrationResult& nominal) {
+  Entry& e = entry(opt);
+  return nominal.volume_form_fallback ? fallback_entry(e, opt) : e;
 }
 
 int RegistrationEngine::solvers_built() const {

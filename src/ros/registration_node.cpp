@@ -322,7 +322,7 @@ bool RegistrationNode::on_register(breast_tumour_registration::Register::Request
       r.sampled_uncertainty = scan ? engine_->sample_uncertainty_live(*scan, lo, opt, opt.uncertainty, samples, 1, r)
                                    : engine_->sample_uncertainty(opt, opt.uncertainty, samples, 1, r);
     }
-    publish_result(r, engine_->prepare(opt).model, preset, res.result);
+    publish_result(r, engine_->prepared_for(opt, r).model, preset, res.result);
     res.success = true;
     res.message = "registered in " + std::to_string(r.seconds) + " s (" + r.steps.describe() + ")";
     for (const auto& step : r.reports) {

@@ -147,10 +147,12 @@ std::string registration_report_json(const Scene& scene, const RegistrationModel
     j["material_model"]["unload_element_order"] = to_string(model.material.unload_element_order);
   if (r.volume_form == VolumeForm::Nodal)
     j["material_model"]["nodal_element_share"] = num(model.material.nodal_element_share);
-  if (const auto& f = r.volume_form_fallback)
+  if (const auto& f = r.volume_form_fallback) {
     j["material_model"]["fallback_from_nodal"] = {{"nodal_stop", f->nodal_stop},
                                                   {"nodal_seconds", num(f->nodal_seconds)},
                                                   {"element_prepare_seconds", num(f->prepare_seconds)}};
+    if (!f->mesh_note.empty()) j["material_model"]["fallback_from_nodal"]["element_mesh"] = f->mesh_note;
+  }
   if (r.steps.stiffness) {
     Json evaluations = Json::array();
     for (const auto& c : r.stiffness_evaluations) {

@@ -197,7 +197,14 @@ int main(int argc, char** argv) {
       std::printf("[sampled ] %d samples (%d not converged, %d failed), %.3f s each%s%s%s\n", su.samples, su.not_converged,
                   su.failed, su.seconds_per_sample, reference, su.note.empty() ? "" : ": ", su.note.c_str());
     }
-    const auto files = write_registration_outputs(out_dir, sim, model, r, prepare);
+    // The mesh and model the result was computed on (the element form's own mesh where a preset's
+    // nodal form fell back to it).
+    const PreparedScene& computed = engine.prepared_for(opt, r);
+    if (r.volume_form_fallback && !r.volume_form_fallback->mesh_note.empty())
+      std::printf("[register] the result is the element form's on %ld vertices, %ld tetrahedra (%s)\n",
+                  static_cast<long>(computed.model.rest.V.rows()), static_cast<long>(computed.model.rest.T.rows()),
+                  r.volume_form_fallback->mesh_note.c_str());
+    const auto files = write_registration_outputs(out_dir, computed.scene, computed.model, r, prepare);
     std::printf("[register] registration %.3f s (tetrahedralization %.2f s, preparation %.2f s); wrote %zu files to %s "
                 "(report.json, cross_section.png, registered.vtk, ...)\n",
                 r.seconds, prepared.mesh_seconds, prepare, files.size(),

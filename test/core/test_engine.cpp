@@ -150,6 +150,73 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   EXPECT_EQ(RegistrationEngine(prone_rest).prepare(balanced).model.volume_form, VolumeForm::Element);
 }
 
+// Where the nodal form was the preset's choice (balanced: nodal on a 9 mm mesh where a scene
+// unloads), a nodal registration that does not converge falls back to the call as it would be
+// without that choice: the element form on the preset's element mesh (7 mm), not on the nodal
+// form's coarser mesh. The result, its prepared scene and its samples are that call's. Case: the
+// fallback case below, unloaded; the element form on the scene's 12 mm mesh, the nodal on a
+// coarser one.
+TEST(Engine, APresetsNodalFormFallsBackToTheElementFormOnThePresetsElementMesh) {
+  const std::string d = btr::test::write_coarse_phantom("phantom12_400_fallback", 400);
+  Scene s = load_meshed_scene(d + "/scene.yaml");
+  s.steps = {"landmarks", "surface"};
+  s.prone_gravity = Vec3(0, 0, 9.81);
+  apply_misalignment(s, misalignment_from_degrees_mm(Vec3::Zero(), Vec3(0, 0, 10)));
+  RegistrationOptions opt = preset_options("balanced");
+  opt.simulation_cell_size = 0;  // the element form on the scene's mesh
+  opt.nodal_simulation_cell_size = 0.02;  // coarser: re-tetrahedralized
+  ASSERT_TRUE(takes_preset_volume_form(s, opt));
+  RegistrationOptions own = opt;  // the call without the preset's nodal form
+  own.volume_form = VolumeForm::Auto;
+
+  Scene kept_scene = s;
+  kept_scene.nodal_fallback = false;
+  RegistrationEngine kept_engine(kept_scene);
+  const RegistrationResult kept = kept_engine.solve(opt);
+  ASSERT_FALSE(kept.converged) << "the case no longer needs the fallback";
+  EXPECT_EQ(kept.volume_form, VolumeForm::Nodal);
+  EXPECT_LT(kept.x.rows(), s.prone.V.rows());  // on the nodal form's coarser mesh
+  const RegistrationResult reference = fresh(s, own);
+  ASSERT_TRUE(reference.converged) << btr::test::step_stops(reference);
+
+  RegistrationEngine engine(s);
+  const RegistrationResult r = engine.solve(opt);
+  EXPECT_TRUE(r.converged) << btr::test::step_stops(r);
+  EXPECT_EQ(r.volume_form, VolumeForm::Element);
+  ASSERT_TRUE(r.volume_form_fallback);
+  EXPECT_EQ(r.volume_form_fallback->mesh_note, "the scene's mesh");
+  EXPECT_GT(r.volume_form_fallback->prepare_seconds, 0.0);
+  EXPECT_TRUE(btr::test::has_warning(r, "registered again with the element form on the preset's mesh for it (the scene's mesh), which converged"));
+  EXPECT_EQ(largest_difference(r.x, reference.x), 0.0);  // the element form's own call, bit for bit
+  const PreparedScene& computed = engine.prepared_for(opt, r);
+  EXPECT_EQ(&computed, &engine.prepare(own));
+  EXPECT_NE(&computed, &engine.prepare(opt));
+  EXPECT_EQ(computed.model.rest.V.rows(), r.x.rows());
+  EXPECT_EQ(computed.model.volume_form, VolumeForm::Element);
+  const RegistrationResult again = engine.solve(opt);  // prepared once
+  ASSERT_TRUE(again.volume_form_fallback);
+  EXPECT_EQ(again.volume_form_fallback->prepare_seconds, 0.0);
+  EXPECT_EQ(largest_difference(again.x, reference.x), 0.0);
+
+  // The samples are drawn on the element form's mesh: as an engine that registers `own` draws them.
+  UncertaintyOptions sources;
+  sources.sources.youngs_modulus_range = {3000, 3800};
+  sources.sources.gravity_direction_deg = 0;
+  sources.sources.landmark_sd = 0;
+  sources.sources.depth_noise = 0;
+  sources.sources.discretisation = false;
+  const SampledUncertainty su = engine.sample_uncertainty(opt, sources, 2, 1, r);
+  RegistrationEngine element_engine(s);
+  const SampledUncertainty se = element_engine.sample_uncertainty(own, sources, 2, 1, element_engine.solve(own));
+  ASSERT_EQ(su.samples, 2) << su.note;
+  ASSERT_EQ(su.tumours.size(), se.tumours.size());
+  for (size_t i = 0; i < su.tumours.size(); ++i) {
+    ASSERT_EQ(su.tumours[i].centroids.size(), se.tumours[i].centroids.size());
+    for (size_t k = 0; k < su.tumours[i].centroids.size(); ++k)
+      EXPECT_EQ((su.tumours[i].centroids[k] - se.tumours[i].centroids[k]).norm(), 0.0);
+  }
+}
+
 // The nodal volume form folds coarse soft meshes where the element form's locking holds them
 // together (BENCHMARKS.md, "The nodal volume term as the default"). Where a nodal registration
 // ends not converged the engine registers again with the element form, returns that result and

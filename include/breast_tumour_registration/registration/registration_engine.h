@@ -8,6 +8,7 @@
 // Not thread-safe: one solve at a time (the node serialises its service calls).
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -53,10 +54,14 @@ class RegistrationEngine {
 
   /// Registers the scene's own supine side. The result's warnings start with the preparation's.
   /// Every solve (not the samples' re-registrations) with the nodal volume form that ends not
-  /// converged is run again with the element form on the same mesh where the scene allows it
+  /// converged is run again with the element form where the scene allows it
   /// (Scene::nodal_fallback, the default), and the element form's result is returned with
   /// RegistrationResult::volume_form_fallback set and a warning: on coarse soft meshes the nodal
   /// form folds where the element form holds (BENCHMARKS.md, "The fallback to the element form").
+  /// The element form runs on the same mesh where the scene chose the nodal form, and on the
+  /// preset's element mesh where the preset did (the call as it would be without the preset's
+  /// nodal form: balanced's 7 mm, not its nodal 9 mm, so a fallback is never coarser than the
+  /// element form's own default).
   RegistrationResult solve(const RegistrationOptions& opt, const StepCallback& callback = {});
   /// Registers `supine` (this engine's scene, or a copy whose supine side, landmarks' supine
   /// positions, ground truth or steps were replaced) on the prepared prone side; InputError when
@@ -87,6 +92,11 @@ class RegistrationEngine {
                                              const UncertaintyOptions& sources, int samples, unsigned seed,
                                              const RegistrationResult& nominal);
 
+  /// The prepared scene a result of solve(opt, ...) or solve_live was computed on: prepare(opt),
+  /// or where it fell back to the element form, the entry that form ran on (another mesh where
+  /// the nodal form was the preset's). Its model is the one to write the result with.
+  const PreparedScene& prepared_for(const RegistrationOptions& opt, const RegistrationResult& r);
+
   const Scene& scene() const { return scene_; }  ///< as given
   int solvers_built() const;   ///< over every prepared mesh
   int solvers_reused() const;
@@ -101,6 +111,8 @@ class RegistrationEngine {
     std::unique_ptr<Entry> twin;
     Entry* twin_of = nullptr;  ///< the entry this one is the twin of
   };
+  /// The supine scene of a call on an entry's prepared scene, and the call's options for it
+  using SupineFor = std::function<Scene(const Entry&, RegistrationOptions&)>;
   /// The entry a call simulates on: opt's simulation mesh, with the preset's nodal form where the
   /// scene's volume form is auto and the scene unloads (takes_preset_volume_form; on the mesh
   /// RegistrationOptions::nodal_simulation_cell_size gives), else the scene's form as resolved;
@@ -117,9 +129,15 @@ class RegistrationEngine {
   std::optional<RegistrationResult> discretisation_reference(Entry& e, const Scene& scene, const RegistrationOptions& opt,
                                                              const RegistrationResult& nominal,
                                                              std::vector<std::string>& notes);
-  /// The entry `nominal` was computed on: e, or its element-form twin where it fell back
-  Entry& nominal_entry(Entry& e, const RegistrationResult& nominal);
-  RegistrationResult run(Entry& e, const Scene& supine, const RegistrationOptions& opt, const StepCallback& callback);
+  /// Where a nodal registration on e falls back to the element form: the preset's element mesh
+  /// where the preset chose the nodal form (entry(opt) with the scene's own form), else e's twin
+  Entry& fallback_entry(Entry& e, const RegistrationOptions& opt);
+  int prepared_entries() const;  ///< entries and twins
+  /// The entry `nominal` was computed on: entry(opt), or its fallback_entry where it fell back
+  Entry& nominal_entry(const RegistrationOptions& opt, const RegistrationResult& nominal);
+  /// Registers on e the supine scene supine_for makes; falls back as solve() says
+  RegistrationResult run(Entry& e, const SupineFor& supine_for, const RegistrationOptions& opt,
+                         const StepCallback& callback);
   /// The scene of a live scan on `e`'s prepared scene; `opt` takes the tracked pose it decides
   /// and that pose's covariance (solve_live and sample_uncertainty_live alike).
   static Scene live_call(const Entry& e, const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions& opt);

@@ -167,6 +167,11 @@ struct RegistrationResult {
     std::string nodal_stop;      ///< the nodal attempt's unconverged steps and their stop reasons
     double nodal_seconds = 0;    ///< its registration time [s] (in `seconds`)
     double prepare_seconds = 0;  ///< preparing the element form's model (first fallback only; in `seconds`)
+    /// Where the nodal form was the preset's (RegistrationOptions::volume_form), the element form
+    /// runs on the mesh the preset simulates it on, as if the preset had not taken the nodal form:
+    /// how that mesh was made ("re-tetrahedralized the prone model at 7.0 mm", or "the scene's
+    /// mesh"); empty where the fallback ran on the nodal attempt's own mesh.
+    std::string mesh_note;
   };
   std::optional<VolumeFormFallback> volume_form_fallback;
   /// [m] the supine mesh's estimated noise along its normals (0: not estimated: no mesh, or
