@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_simulation.h"
 #include "breast_tumour_registration/simulation/phantom.h"
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     PhantomOptions po;
-    po.tet.cell_size = cell_mm * 1e-3;
+    po.tet.cell_size = mm_to_m(cell_mm);
     auto t0 = std::chrono::steady_clock::now();
     const PhantomModel model = make_phantom_model(po);
     const double t_mesh = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1,3 +1,4 @@
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/io/scene.h"
 
 #include <yaml-cpp/yaml.h>
@@ -121,7 +122,7 @@ Scene load_scene_fields(const std::string& path) {
     s.prone_source = ProneSurfaceSource{};
     s.prone_source->surface = prone_surface;
     if (prone["cell_size_mm"]) {
-      const double cell = c.number(prone["cell_size_mm"], "prone.cell_size_mm") * 1e-3;
+      const double cell = mm_to_m(c.number(prone["cell_size_mm"], "prone.cell_size_mm"));
       if (!(cell > 0) || !std::isfinite(cell)) c.fail("prone.cell_size_mm", "must be positive");
       s.prone_source->cell_size = cell;
     }

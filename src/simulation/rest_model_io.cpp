@@ -1,3 +1,4 @@
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/simulation/rest_model_io.h"
 
 #include <algorithm>
@@ -117,7 +118,7 @@ PhantomModel load_rest_model_fields(const std::string& path) {
   }
   if (!root["rest"]) {
     TetrahedralizeOptions topt;
-    topt.cell_size = root["cell_size_mm"] ? c.number(root["cell_size_mm"], "cell_size_mm") * 1e-3 : kDefaultCellSize;
+    topt.cell_size = root["cell_size_mm"] ? mm_to_m(c.number(root["cell_size_mm"], "cell_size_mm")) : kDefaultCellSize;
     if (!(topt.cell_size > 0)) c.fail("cell_size_mm", "must be positive");
     m.rest = c.load("cell_size_mm", [&] { return tetrahedralize(input_surface, topt); });
   }

@@ -3,6 +3,7 @@
 // comparison table with the thesis come from scripts/plot_experiments.py.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <chrono>
@@ -122,7 +123,7 @@ int main(int argc, char** argv) {
     opt.quick = quick;
     opt.preset = preset;
     opt.rest_shape = rest_shape;
-    opt.simulation_cell_size = simulation_cell_mm * 1e-3;
+    opt.simulation_cell_size = mm_to_m(simulation_cell_mm);
     opt.method_volume_form = parse_volume_form(volume_form);
     opt.method_nodal_element_share = nodal_element_share;
     opt.method_unload_element_order = unload_elements;
@@ -146,7 +147,7 @@ int main(int argc, char** argv) {
       }
     } else {
       PhantomOptions po;
-      po.tet.cell_size = cell_mm * 1e-3;
+      po.tet.cell_size = mm_to_m(cell_mm);
       model = make_phantom_model(po);
     }
     const size_t n_moduli = opt.generating_youngs_moduli.empty() ? thesis_youngs_moduli().size() : opt.generating_youngs_moduli.size();

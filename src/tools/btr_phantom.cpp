@@ -2,6 +2,7 @@
 // and supine configurations under gravity, and writes a scene that later steps can load.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <chrono>
@@ -93,7 +94,7 @@ int main(int argc, char** argv) {
     o.element_order = element_order;
     o.nodal_element_share = nodal_element_share;
     o.density = rho;
-    o.phantom.tet.cell_size = cell_mm * 1e-3;
+    o.phantom.tet.cell_size = mm_to_m(cell_mm);
     o.phantom.tet.radius_edge_ratio = ratio;
     o.phantom.tumour_radius = tumour_mm * 1e-3;
     o.tumour_youngs_modulus = tumour_E;

@@ -2,6 +2,7 @@
 // registered meshes, tumours, report.json and cross_section.png.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <algorithm>
@@ -76,11 +77,11 @@ int main(int argc, char** argv) {
     }
     if (tumour_E > 0) scene.tumour_youngs_modulus = tumour_E;
     RegistrationOptions opt = preset_options(scene.preset);
-    if (cell_mm >= 0) opt.simulation_cell_size = opt.nodal_simulation_cell_size = cell_mm * 1e-3;  // whatever the form
+    if (cell_mm >= 0) opt.simulation_cell_size = opt.nodal_simulation_cell_size = mm_to_m(cell_mm);  // whatever the form
     opt.uncertainty.enabled = uncertainty != "none";
     opt.uncertainty.sources = scene.uncertainty;  // the defaults unless the scene's `uncertainty:` says otherwise
     // --cell-size, else prone.cell_size_mm, else the preset's simulation mesh (the engine meshes once).
-    if (scene.prone_source && cell_mm > 0) scene.prone_source->cell_size = cell_mm * 1e-3;
+    if (scene.prone_source && cell_mm > 0) scene.prone_source->cell_size = mm_to_m(cell_mm);
     RegistrationEngine engine(std::move(scene));
     const PreparedScene& prepared = engine.prepare(opt);
     const Scene& sim = prepared.scene;

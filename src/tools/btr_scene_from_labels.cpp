@@ -2,6 +2,7 @@
 // with its skin fiducials and a supine surface becomes a registration scene for btr_register.
 #include <CLI/CLI.hpp>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <cstdio>
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
     const LabelTable table = table_path.empty() ? LabelTable{} : read_label_table(table_path, v);
     LabelSceneOptions o;
     o.mesh.source = label_map;
-    o.mesh.cell_size = cell_mm * 1e-3;
+    o.mesh.cell_size = mm_to_m(cell_mm);
     o.mesh.tumour_facet_size = tumour_facet_mm * 1e-3;
     o.mesh.protect_features = !no_features;
     o.prone_landmarks = prone_lm;

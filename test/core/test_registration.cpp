@@ -667,6 +667,13 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   EXPECT_EQ(l.prone.T.rows(), 0);
   ASSERT_TRUE(l.prone_source.has_value());
   EXPECT_EQ(l.prone_source->cell_size.value_or(0), 0.012);
+  // A size in millimetres is the preset's size in metres to the bit: 9 * 1e-3 is not 0.009, and
+  // CGAL meshed other tetrahedra for it than for the balanced preset's nodal 9 mm.
+  const Scene nine = load_scene(scene_with(
+      "prone: {surface: prone_skin_surface.obj, cell_size_mm: 9}\nchest_wall: chest_wall_surface.txt\nlandmarks: landmarks_surface.csv",
+      "nine_mm"));
+  ASSERT_TRUE(nine.prone_source.has_value());
+  EXPECT_EQ(nine.prone_source->cell_size.value_or(0), preset_options("balanced").nodal_simulation_cell_size);
   mesh_prone(l, 0.012);
   EXPECT_TRUE(l.tetrahedralized);
   EXPECT_NEAR(static_cast<double>(l.prone.T.rows()), static_cast<double>(s.prone.T.rows()), 0.02 * s.prone.T.rows());
