@@ -17,6 +17,7 @@
 #include <sstream>
 #include <vector>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
@@ -58,7 +59,19 @@ int main(int argc, char** argv) {
   app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance target_normals");
   CLI11_PARSE(app, argc, argv);
   try {
-    const Scene scene = load_meshed_scene(scene_path);
+    // A prone surface is meshed once per cell size, at that size, as btr_register and the engine
+    // mesh it (before 2026-12-06, eighth session, it was meshed at its own size first and then
+    // re-tetrahedralized: another mesh than a user's call simulates); a tetrahedral prone model
+    // is re-tetrahedralized at each size.
+    const Scene scene = load_scene(scene_path);
+    const auto simulation_scene = [&scene](double cell_mm) {
+      Scene s = scene;
+      if (s.prone_source)
+        mesh_prone(s, cell_mm > 0 ? mm_to_m(cell_mm) : s.prone_source->cell_size.value_or(kDefaultCellSize));
+      else if (cell_mm > 0)
+        s = with_simulation_mesh(s, mm_to_m(cell_mm));
+      return s;
+    };
     std::vector<Point> points;
     for (const std::string preset : {"fast", "balanced", "accurate"}) {
       for (double c : cells) points.push_back({"cell_size_mm", fmt(c), preset, c, preset_options(preset)});
@@ -113,7 +126,7 @@ int main(int argc, char** argv) {
     for (const Point& p : points) {
       if (!engines.count(p.cell_mm)) {
         const auto t0 = std::chrono::steady_clock::now();
-        Scene s = p.cell_mm > 0 ? with_simulation_mesh(scene, p.cell_mm * 1e-3) : scene;
+        Scene s = simulation_scene(p.cell_mm);
         std::vector<std::string> warnings;
         RegistrationModel m = prepare_model(s, warnings);
         prepare_seconds[p.cell_mm] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -24,7 +24,8 @@ double worst_mm(const RegistrationResult& r) {
   return w * 1e3;
 }
 void print(const char* what, const RegistrationResult& r) {
-  std::printf("%-34s worst %.3f mm, %6.2f s, %s, %s form%s%s\n", what, worst_mm(r), r.seconds,
+  std::printf("%-34s worst %.3f mm, %6ld vertices, E %.0f Pa, %6.2f s, %s, %s form%s%s\n", what, worst_mm(r),
+              static_cast<long>(r.x.rows()), r.estimated_youngs_modulus, r.seconds,
               r.converged ? "converged" : "NOT converged", to_string(r.volume_form),
               r.volume_form_fallback ? ", fell back: " : "",
               r.volume_form_fallback ? (r.volume_form_fallback->mesh_note.empty() ? "same mesh" : r.volume_form_fallback->mesh_note.c_str()) : "");
