@@ -32,7 +32,8 @@ struct RegistrationOptions {
   /// The preset's volume form, taken by RegistrationEngine where the scene's material.volume_form
   /// is `auto` and the scene plans the unloaded shape (prone_gravity): Nodal registers such a scene
   /// with the nodal form, on the mesh nodal_simulation_cell_size gives. An explicit element or
-  /// nodal in the scene wins; Auto leaves the form to Poisson's ratio (kNodalVolumeFromPoisson).
+  /// nodal in the scene wins; Auto (and Element, which no preset needs: Poisson's ratio gives the
+  /// element form at the thesis's nu) leaves the form to Poisson's ratio (kNodalVolumeFromPoisson).
   /// Only unloading scenes: with the prone shape as the rest shape on soft tissue the nodal form
   /// folds the mesh and ends farther off (BENCHMARKS.md, "The nodal volume term as the default").
   VolumeForm volume_form = VolumeForm::Auto;
