@@ -5,7 +5,11 @@
 // each point it writes one CSV row: median registration seconds over the repeats (the cost
 // of a service call once the model is prepared), the one-off preparation seconds, and the
 // worst and mean tumour centroid error. Plot with bench/plot_tradeoff.py.
-//   btr_bench_tradeoff SCENE.yaml --repeats 3 --out tradeoff.csv
+// A mesh is one draw: a 1 % change of cell size moves the worst tumour by up to 0.28 mm on
+// SfePy's bodies (BENCHMARKS.md, "One mesh is one draw"). --mesh-draws N runs each point with a
+// cell size at N sizes spread evenly over +-(--mesh-jitter) of it and reports the medians and
+// the worst error's range over them.
+//   btr_bench_tradeoff SCENE.yaml --repeats 3 --out tradeoff.csv [--mesh-draws 5]
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -55,6 +59,14 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "timed registrations per setting (median)")->capture_default_str();
   app.add_option("--cell-sizes", cells, "simulation mesh cell sizes to sweep [mm]");
   app.add_option("-o,--out", out_path, "CSV file")->capture_default_str();
+  int mesh_draws = 1;
+  double mesh_jitter = 0.01;
+  app.add_option("--mesh-draws", mesh_draws, "meshes per point with a cell size (sizes spread over +-jitter)")
+      ->check(CLI::Range(1, 99))
+      ->capture_default_str();
+  app.add_option("--mesh-jitter", mesh_jitter, "relative spread of the draws' cell sizes")
+      ->check(CLI::Range(0.0, 0.2))
+      ->capture_default_str();
   std::vector<std::string> knobs;
   app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance target_normals");
   CLI11_PARSE(app, argc, argv);
@@ -119,41 +131,64 @@ int main(int argc, char** argv) {
     std::ofstream csv(out_path);
     if (!csv) throw InputError("cannot write '" + out_path + "'");
     csv << "knob,value,base_preset,cell_size_mm,tetrahedra,prepare_seconds,seconds_median,worst_error_mm,mean_error_mm,"
-           "converged,volume_form\n";
+           "converged,volume_form,mesh_draws,worst_error_min_mm,worst_error_max_mm\n";
     // One engine per simulation mesh (as the node keeps it): prepared once, solved repeatedly.
     std::map<double, std::unique_ptr<RegistrationEngine>> engines;
     std::map<double, double> prepare_seconds;
     for (const Point& p : points) {
-      if (!engines.count(p.cell_mm)) {
-        const auto t0 = std::chrono::steady_clock::now();
-        Scene s = simulation_scene(p.cell_mm);
-        std::vector<std::string> warnings;
-        RegistrationModel m = prepare_model(s, warnings);
-        prepare_seconds[p.cell_mm] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        engines.emplace(p.cell_mm, std::make_unique<RegistrationEngine>(std::move(s), std::move(m), std::move(warnings)));
+      // The point's cell sizes: its own, or mesh_draws sizes over +-mesh_jitter of it.
+      std::vector<double> sizes{p.cell_mm};
+      if (p.cell_mm > 0 && mesh_draws > 1) {
+        sizes.clear();
+        for (int k = 0; k < mesh_draws; ++k)
+          sizes.push_back(p.cell_mm * (1 + mesh_jitter * (2.0 * k / (mesh_draws - 1) - 1)));
       }
-      RegistrationEngine& engine = *engines.at(p.cell_mm);
-      const RegistrationModel& m = engine.prepare(p.opt).model;
-      std::vector<double> secs;
-      RegistrationResult r;
-      for (int i = 0; i < repeats; ++i) {
-        r = engine.solve(p.opt);
-        secs.push_back(r.seconds);
+      std::vector<double> secs, worsts, means, tets, prepares;
+      int converged = 0;
+      std::string forms;
+      for (double c : sizes) {
+        if (!engines.count(c)) {
+          const auto t0 = std::chrono::steady_clock::now();
+          Scene s = simulation_scene(c);
+          std::vector<std::string> warnings;
+          RegistrationModel m = prepare_model(s, warnings);
+          prepare_seconds[c] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          engines.emplace(c, std::make_unique<RegistrationEngine>(std::move(s), std::move(m), std::move(warnings)));
+        }
+        RegistrationEngine& engine = *engines.at(c);
+        tets.push_back(static_cast<double>(engine.prepare(p.opt).model.rest.T.rows()));
+        prepares.push_back(prepare_seconds[c]);
+        std::vector<double> draw_secs;
+        RegistrationResult r;
+        for (int i = 0; i < repeats; ++i) {
+          r = engine.solve(p.opt);
+          draw_secs.push_back(r.seconds);
+        }
+        secs.push_back(median(draw_secs));
+        double worst = 0, mean = 0;
+        for (const auto& t : r.tumours) {
+          worst = std::max(worst, t.centroid_distance * 1e3);
+          mean += t.centroid_distance * 1e3 / static_cast<double>(r.tumours.size());
+        }
+        worsts.push_back(worst);
+        means.push_back(mean);
+        converged += r.converged ? 1 : 0;
+        const std::string form = r.volume_form_fallback ? "element_fallback" : to_string(r.volume_form);
+        if (forms.find(form) == std::string::npos) forms += (forms.empty() ? "" : "+") + form;
+        if (sizes.size() > 1)
+          std::printf("  draw at %.3f mm: %.0f tets, %.3f s, worst %.3f mm%s\n", c, tets.back(), secs.back(), worst,
+                      r.converged ? "" : " (not converged)");
+        if (r.volume_form_fallback) std::printf("  (the nodal form did not converge: the element form's result)\n");
       }
-      double worst = 0, mean = 0;
-      for (const auto& t : r.tumours) {
-        worst = std::max(worst, t.centroid_distance * 1e3);
-        mean += t.centroid_distance * 1e3 / static_cast<double>(r.tumours.size());
-      }
-      csv << p.knob << ',' << p.value << ',' << p.base << ',' << p.cell_mm << ',' << m.rest.T.rows() << ','
-          << prepare_seconds[p.cell_mm] << ',' << median(secs) << ',' << worst << ',' << mean << ','
-          << (r.converged ? 1 : 0) << ','
-          << (r.volume_form_fallback ? "element_fallback" : to_string(r.volume_form)) << '\n';
+      const int n = static_cast<int>(sizes.size());
+      csv << p.knob << ',' << p.value << ',' << p.base << ',' << p.cell_mm << ',' << median(tets) << ','
+          << median(prepares) << ',' << median(secs) << ',' << median(worsts) << ',' << median(means) << ','
+          << (converged == n ? 1 : 0) << ',' << forms << ',' << n << ','
+          << *std::min_element(worsts.begin(), worsts.end()) << ',' << *std::max_element(worsts.begin(), worsts.end()) << '\n';
       csv.flush();
-      std::printf("%-18s %-10s %-8s cell %4.1f mm %6ld tets: %.3f s, worst %.3f mm, mean %.3f mm%s\n", p.knob.c_str(),
-                  p.value.c_str(), p.base.c_str(), p.cell_mm, static_cast<long>(m.rest.T.rows()), median(secs), worst, mean,
-                  r.converged ? "" : " (not converged)");
-      if (r.volume_form_fallback) std::printf("  (the nodal form did not converge: the element form's result)\n");
+      std::printf("%-18s %-10s %-8s cell %4.1f mm %6.0f tets: %.3f s, worst %.3f mm, mean %.3f mm%s\n", p.knob.c_str(),
+                  p.value.c_str(), p.base.c_str(), p.cell_mm, median(tets), median(secs), median(worsts), median(means),
+                  converged == n ? "" : (" (" + std::to_string(n - converged) + " of " + std::to_string(n) + " not converged)").c_str());
       std::fflush(stdout);
     }
     return 0;

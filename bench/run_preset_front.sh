@@ -7,7 +7,9 @@
 # quadratic). One OpenMP thread per process; JOBS processes side by side. The scene copies are
 # written beside the scenes (their relative paths stay valid) and removed at the end.
 # Summary: python3 bench/summarize_preset_front.py OUT
-# Usage: [JOBS=2] [REPEATS=3] [CELLS="5 7 9"] [FORMS="element nodal"] bash bench/run_preset_front.sh OUT name=scene.yaml ...
+# MESH_DRAWS=N: each point with a cell size on N meshes within 1 % of it (medians and the range;
+# a mesh is one draw: BENCHMARKS.md, "One mesh is one draw").
+# Usage: [JOBS=2] [REPEATS=3] [CELLS="5 7 9"] [FORMS="element nodal"] [MESH_DRAWS=1] bash bench/run_preset_front.sh OUT name=scene.yaml ...
 set -euo pipefail
 OUT=${1:?usage: run_preset_front.sh OUT name=scene.yaml ...}
 shift
@@ -15,6 +17,7 @@ JOBS=${JOBS:-2}
 REPEATS=${REPEATS:-3}
 CELLS=${CELLS:-5 7 9}
 FORMS=${FORMS:-element nodal}
+MESH_DRAWS=${MESH_DRAWS:-1}
 here=$(cd "$(dirname "$0")" && pwd)
 bin="$here/../build/ws/devel/lib/breast_tumour_registration"
 mkdir -p "$OUT"
@@ -39,9 +42,9 @@ PY
 done
 run() {  # name form scene
   OMP_NUM_THREADS=1 "$bin/btr_bench_tradeoff" "$3" --repeats "$REPEATS" --knobs preset cell_size_mm \
-    --cell-sizes $CELLS -o "$OUT/$1_$2.csv" > "$OUT/$1_$2.log" 2>&1 || echo "$1 $2: exit $?" >> "$OUT/failures.txt"
+    --cell-sizes $CELLS --mesh-draws "$MESH_DRAWS" -o "$OUT/$1_$2.csv" > "$OUT/$1_$2.log" 2>&1 || echo "$1 $2: exit $?" >> "$OUT/failures.txt"
 }
 export -f run
-export OUT REPEATS CELLS bin
+export OUT REPEATS CELLS MESH_DRAWS bin
 printf '%s\n' "${jobs_list[@]}" | xargs -P "$JOBS" -L 1 bash -c 'run "$0" "$1" "$2"'
 echo "wrote $OUT/*.csv"
