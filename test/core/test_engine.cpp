@@ -24,6 +24,29 @@ RegistrationResult fresh(const Scene& s, const RegistrationOptions& opt) {
   return run_registration(s, m, opt);
 }
 
+/// E drawn over a narrow range and every other source off (the discretisation too): the
+/// samples then show which model and mesh drew them.
+UncertaintyOptions stiffness_only_sources() {
+  UncertaintyOptions sources;
+  sources.sources.youngs_modulus_range = {3000, 3800};
+  sources.sources.gravity_direction_deg = 0;
+  sources.sources.landmark_sd = 0;
+  sources.sources.depth_noise = 0;
+  sources.sources.discretisation = false;
+  return sources;
+}
+
+/// Two samples each, with the same centroids to the bit.
+void expect_same_samples(const SampledUncertainty& a, const SampledUncertainty& b) {
+  ASSERT_EQ(a.samples, 2) << a.note;
+  ASSERT_EQ(a.tumours.size(), b.tumours.size());
+  for (size_t i = 0; i < a.tumours.size(); ++i) {
+    ASSERT_EQ(a.tumours[i].centroids.size(), b.tumours[i].centroids.size());
+    for (size_t k = 0; k < a.tumours[i].centroids.size(); ++k)
+      EXPECT_EQ((a.tumours[i].centroids[k] - b.tumours[i].centroids[k]).norm(), 0.0);
+  }
+}
+
 }  // namespace
 
 TEST(Engine, RepeatedSolvesGiveTheFreshAnswerAndReuseEveryStepsSolver) {
@@ -199,22 +222,10 @@ TEST(Engine, APresetsNodalFormFallsBackToTheElementFormOnThePresetsElementMesh) 
   EXPECT_EQ(largest_difference(again.x, reference.x), 0.0);
 
   // The samples are drawn on the element form's mesh: as an engine that registers `own` draws them.
-  UncertaintyOptions sources;
-  sources.sources.youngs_modulus_range = {3000, 3800};
-  sources.sources.gravity_direction_deg = 0;
-  sources.sources.landmark_sd = 0;
-  sources.sources.depth_noise = 0;
-  sources.sources.discretisation = false;
-  const SampledUncertainty su = engine.sample_uncertainty(opt, sources, 2, 1, r);
+  const UncertaintyOptions sources = stiffness_only_sources();
   RegistrationEngine element_engine(s);
-  const SampledUncertainty se = element_engine.sample_uncertainty(own, sources, 2, 1, element_engine.solve(own));
-  ASSERT_EQ(su.samples, 2) << su.note;
-  ASSERT_EQ(su.tumours.size(), se.tumours.size());
-  for (size_t i = 0; i < su.tumours.size(); ++i) {
-    ASSERT_EQ(su.tumours[i].centroids.size(), se.tumours[i].centroids.size());
-    for (size_t k = 0; k < su.tumours[i].centroids.size(); ++k)
-      EXPECT_EQ((su.tumours[i].centroids[k] - se.tumours[i].centroids[k]).norm(), 0.0);
-  }
+  expect_same_samples(engine.sample_uncertainty(opt, sources, 2, 1, r),
+                      element_engine.sample_uncertainty(own, sources, 2, 1, element_engine.solve(own)));
 }
 
 // The nodal volume form folds coarse soft meshes where the element form's locking holds them
@@ -267,22 +278,11 @@ TEST(Engine, ANodalRegistrationThatDoesNotConvergeFallsBackToTheElementForm) {
   EXPECT_EQ(largest_difference(again.x, reference.x), 0.0);
   // The samples are the element form's: the same draws on an element-form engine give the same
   // centroids, to the bit.
-  UncertaintyOptions sources;
-  sources.sources.youngs_modulus_range = {3000, 3800};
-  sources.sources.gravity_direction_deg = 0;
-  sources.sources.landmark_sd = 0;
-  sources.sources.depth_noise = 0;
+  const UncertaintyOptions sources = stiffness_only_sources();
   const SampledUncertainty su = engine.sample_uncertainty(opt, sources, 2, 1, r);
-  RegistrationEngine element_engine(element);
-  const SampledUncertainty se = element_engine.sample_uncertainty(opt, sources, 2, 1, element_engine.solve(opt));
-  ASSERT_EQ(su.samples, 2) << su.note;
   EXPECT_NE(su.note.find("sampled with the element volume form"), std::string::npos) << su.note;
-  ASSERT_EQ(su.tumours.size(), se.tumours.size());
-  for (size_t i = 0; i < su.tumours.size(); ++i) {
-    ASSERT_EQ(su.tumours[i].centroids.size(), se.tumours[i].centroids.size());
-    for (size_t k = 0; k < su.tumours[i].centroids.size(); ++k)
-      EXPECT_EQ((su.tumours[i].centroids[k] - se.tumours[i].centroids[k]).norm(), 0.0);
-  }
+  RegistrationEngine element_engine(element);
+  expect_same_samples(su, element_engine.sample_uncertainty(opt, sources, 2, 1, element_engine.solve(opt)));
 
   // Where the nodal form converges (the aligned scan with the rigid step), it is the answer.
   Scene aligned = load_meshed_scene(d + "/scene.yaml");

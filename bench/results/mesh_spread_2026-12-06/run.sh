@@ -1,7 +1,8 @@
-# Mesh chaos: the default call's worst tumour error over cell sizes within +-1 % of the preset's.
+# Mesh chaos (name=scene.yaml arguments, else the four below): the default call's worst tumour error over cell sizes within +-1 % of the preset's.
 cd /work/main
 B=build/ws/devel/lib/breast_tumour_registration
-for sc in S1_1000=test/data/independent_truth_E1000/scene_estimated_regions.yaml S1_3400=test/data/independent_truth_E3400/scene_estimated_regions.yaml S2_500=/tmp/front/B/E500/scene_estimated_regions.yaml S2_1000=/tmp/front/B/E1000/scene_estimated_regions.yaml; do
+DEFAULT_SCENES="S1_1000=test/data/independent_truth_E1000/scene_estimated_regions.yaml S1_3400=test/data/independent_truth_E3400/scene_estimated_regions.yaml S2_500=/tmp/front/B/E500/scene_estimated_regions.yaml S2_1000=/tmp/front/B/E1000/scene_estimated_regions.yaml"
+for sc in ${@:-$DEFAULT_SCENES}; do
   name=${sc%%=*}; scene=${sc#*=}; dir=$(dirname $scene)
   /usr/bin/python3 - "$scene" "$dir/.ms_element.yaml" <<'PY'
 import sys, yaml
