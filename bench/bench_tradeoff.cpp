@@ -67,6 +67,10 @@ int main(int argc, char** argv) {
   app.add_option("--mesh-jitter", mesh_jitter, "relative spread of the draws' cell sizes")
       ->check(CLI::Range(0.0, 0.2))
       ->capture_default_str();
+  std::vector<std::string> base_presets = {"fast", "balanced", "accurate"};
+  app.add_option("--base-presets", base_presets, "the presets whose cell_size_mm and preset points are swept")
+      ->check(CLI::IsMember({"fast", "balanced", "accurate"}))
+      ->capture_default_str();
   std::vector<std::string> knobs;
   app.add_option("--knobs", knobs, "sweep only these: cell_size_mm preset subspace_handles landmark_tolerance max_projections anderson_depth projection_tolerance target_normals");
   CLI11_PARSE(app, argc, argv);
@@ -85,7 +89,7 @@ int main(int argc, char** argv) {
       return s;
     };
     std::vector<Point> points;
-    for (const std::string preset : {"fast", "balanced", "accurate"}) {
+    for (const std::string& preset : base_presets) {
       for (double c : cells) points.push_back({"cell_size_mm", fmt(c), preset, c, preset_options(preset)});
       // The preset as a user gets it: with its own simulation mesh (the scene's when 0).
       const RegistrationOptions po = preset_options(preset);

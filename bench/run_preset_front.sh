@@ -9,7 +9,7 @@
 # Summary: python3 bench/summarize_preset_front.py OUT
 # MESH_DRAWS=N: each point with a cell size on N meshes within 1 % of it (medians and the range;
 # a mesh is one draw: BENCHMARKS.md, "One mesh is one draw").
-# Usage: [JOBS=2] [REPEATS=3] [CELLS="5 7 9"] [FORMS="element nodal"] [MESH_DRAWS=1] bash bench/run_preset_front.sh OUT name=scene.yaml ...
+# Usage: [JOBS=2] [REPEATS=3] [CELLS="5 7 9"] [FORMS="element nodal"] [MESH_DRAWS=1] [PRESETS="fast balanced accurate"] [KNOBS="preset cell_size_mm"] bash bench/run_preset_front.sh OUT name=scene.yaml ...
 set -euo pipefail
 OUT=${1:?usage: run_preset_front.sh OUT name=scene.yaml ...}
 shift
@@ -18,6 +18,8 @@ REPEATS=${REPEATS:-3}
 CELLS=${CELLS:-5 7 9}
 FORMS=${FORMS:-element nodal}
 MESH_DRAWS=${MESH_DRAWS:-1}
+PRESETS=${PRESETS:-fast balanced accurate}
+KNOBS=${KNOBS:-preset cell_size_mm}
 here=$(cd "$(dirname "$0")" && pwd)
 bin="$here/../build/ws/devel/lib/breast_tumour_registration"
 mkdir -p "$OUT"
@@ -41,10 +43,10 @@ PY
   done
 done
 run() {  # name form scene
-  OMP_NUM_THREADS=1 "$bin/btr_bench_tradeoff" "$3" --repeats "$REPEATS" --knobs preset cell_size_mm \
-    --cell-sizes $CELLS --mesh-draws "$MESH_DRAWS" -o "$OUT/$1_$2.csv" > "$OUT/$1_$2.log" 2>&1 || echo "$1 $2: exit $?" >> "$OUT/failures.txt"
+  OMP_NUM_THREADS=1 "$bin/btr_bench_tradeoff" "$3" --repeats "$REPEATS" --knobs $KNOBS \
+    --cell-sizes $CELLS --mesh-draws "$MESH_DRAWS" --base-presets $PRESETS -o "$OUT/$1_$2.csv" > "$OUT/$1_$2.log" 2>&1 || echo "$1 $2: exit $?" >> "$OUT/failures.txt"
 }
 export -f run
-export OUT REPEATS CELLS MESH_DRAWS bin
+export OUT REPEATS CELLS MESH_DRAWS PRESETS KNOBS bin
 printf '%s\n' "${jobs_list[@]}" | xargs -P "$JOBS" -L 1 bash -c 'run "$0" "$1" "$2"'
 echo "wrote $OUT/*.csv"
