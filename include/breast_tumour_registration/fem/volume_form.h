@@ -23,7 +23,8 @@ enum class VolumeForm { Auto, Element, Nodal };
 /// runs at a cost in accuracy (BENCHMARKS.md, "The nodal form with an element share"). Since
 /// 2026-12-06 a preset may take the nodal form where a scene leaves it to auto and unloads
 /// (RegistrationOptions::volume_form; the balanced preset does, at 9 mm: BENCHMARKS.md, "The
-/// presets' front with the volume form").
+/// presets' front with the volume form"; the accurate preset at 5 mm: "The balanced preset's
+/// fallback, and one mesh is one draw").
 constexpr double kNodalVolumeFromPoisson = 0.495;
 VolumeForm resolve_volume_form(VolumeForm form, double poisson_ratio);
 /// Parses "auto", "element" or "nodal"; InputError otherwise.
