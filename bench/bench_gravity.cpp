@@ -10,8 +10,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/fem/gravity_simulation.h"
 #include "breast_tumour_registration/simulation/phantom.h"
 

@@ -21,8 +21,8 @@
 #include <sstream>
 #include <vector>
 
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
 

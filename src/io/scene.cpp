@@ -1,4 +1,3 @@
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/io/scene.h"
 
 #include <yaml-cpp/yaml.h>
@@ -9,6 +8,7 @@
 #include <filesystem>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/fem/material_region.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
 #include "breast_tumour_registration/fem/element_order.h"

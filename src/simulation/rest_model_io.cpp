@@ -1,4 +1,3 @@
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/simulation/rest_model_io.h"
 
 #include <algorithm>
@@ -6,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/tetrahedralize.h"

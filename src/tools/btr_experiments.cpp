@@ -3,7 +3,6 @@
 // comparison table with the thesis come from scripts/plot_experiments.py.
 #include <CLI/CLI.hpp>
 
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <chrono>
@@ -12,6 +11,7 @@
 #include <fstream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
 #include "breast_tumour_registration/simulation/experiment_shards.h"
 #include "breast_tumour_registration/simulation/experiment_suite.h"

@@ -2,7 +2,6 @@
 // and supine configurations under gravity, and writes a scene that later steps can load.
 #include <CLI/CLI.hpp>
 
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <chrono>
@@ -12,6 +11,7 @@
 #include <iostream>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/simulation/label_phantom.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 

@@ -2,7 +2,6 @@
 // registered meshes, tumours, report.json and cross_section.png.
 #include <CLI/CLI.hpp>
 
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <algorithm>
@@ -14,6 +13,7 @@
 #include <unistd.h>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 

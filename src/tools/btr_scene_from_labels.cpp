@@ -2,13 +2,13 @@
 // with its skin fiducials and a supine surface becomes a registration scene for btr_register.
 #include <CLI/CLI.hpp>
 
-#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/cli_checks.h"
 
 #include <cstdio>
 #include <filesystem>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/io/label_scene.h"
 #include "breast_tumour_registration/io/label_volume_io.h"
 #include "breast_tumour_registration/registration/registration_pipeline.h"
