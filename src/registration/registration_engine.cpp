@@ -155,15 +155,13 @@ RegistrationEngine::Entry& RegistrationEngine::twin_entry(Entry& e, VolumeForm f
   return *e.twin;
 }
 
-RegistrationEngine::Entry& RegistrationEngine::fallback_entry(Entry& e, const RegistrationOptions& opt) {
-  if (!adopted_ && takes_preset_volume_form(scene_, opt)) {
-    // The preset chose the nodal form (on its own mesh): the fallback is the call without that
-    // choice, the element form on the preset's element mesh, never a coarser element model.
-    RegistrationOptions own = opt;
-    own.volume_form = VolumeForm::Auto;
-    return twin_entry(entry(own), VolumeForm::Element);
-  }
-  return twin_entry(e, VolumeForm::Element);
+RegistrationEngine::Entry& RegistrationEngine::fallback_entry(const RegistrationOptions& opt) {
+  // The call without a preset's nodal form: where the preset chose it (on its own mesh), the
+  // element form on the preset's element mesh, never a coarser element model; elsewhere (the
+  // scene's own choice, or an adopted model) entry(own) is entry(opt), and this is its twin.
+  RegistrationOptions own = opt;
+  own.volume_form = VolumeForm::Auto;
+  return twin_entry(entry(own), VolumeForm::Element);
 }
 
 int RegistrationEngine::prepared_entries() const {
@@ -172,8 +170,9 @@ int RegistrationEngine::prepared_entries() const {
   return n;
 }
 
-RegistrationResult RegistrationEngine::run(Entry& e, const SupineFor& supine_for, const RegistrationOptions& opt,
+RegistrationResult RegistrationEngine::run(const SupineFor& supine_for, const RegistrationOptions& opt,
                                            const StepCallback& callback) {
+  Entry& e = entry(opt);
   RegistrationOptions o = opt;
   const Scene supine = supine_for(e, o);
   RegistrationResult r = run_registration(supine, e.prepared.model, o, callback, &e.solvers);
@@ -185,7 +184,7 @@ RegistrationResult RegistrationEngine::run(Entry& e, const SupineFor& supine_for
   why.nodal_stop = unconverged_steps(r);
   why.nodal_seconds = r.seconds;
   const int before = prepared_entries();
-  Entry& f = fallback_entry(e, opt);
+  Entry& f = fallback_entry(opt);
   if (prepared_entries() > before) why.prepare_seconds = f.prepared.prepare_seconds;
   const auto root = [](const Entry& x) { return x.twin_of ? x.twin_of : &x; };
   if (root(f) != root(e)) why.mesh_note = f.prepared.mesh_note.empty() ? "the scene's mesh" : f.prepared.mesh_note;
@@ -206,7 +205,6 @@ RegistrationResult RegistrationEngine::run(Entry& e, const SupineFor& supine_for
 
 RegistrationResult RegistrationEngine::solve(const RegistrationOptions& opt, const StepCallback& callback) {
   return run(
-      entry(opt),
       [](const Entry& x, const RegistrationOptions& o) {
         Scene s = x.prepared.scene;
         s.preset = o.preset;
@@ -218,7 +216,6 @@ RegistrationResult RegistrationEngine::solve(const RegistrationOptions& opt, con
 RegistrationResult RegistrationEngine::solve(const Scene& supine, const RegistrationOptions& opt,
                                              const StepCallback& callback) {
   return run(
-      entry(opt),
       [&supine](const Entry& x, const RegistrationOptions& o) {
         Scene s = with_supine_side(x.prepared.scene, supine);
         s.preset = o.preset;
@@ -229,8 +226,7 @@ RegistrationResult RegistrationEngine::solve(const Scene& supine, const Registra
 
 RegistrationResult RegistrationEngine::solve_live(const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions opt,
                                                   const StepCallback& callback) {
-  return run(
-      entry(opt), [&](const Entry& x, RegistrationOptions& o) { return live_call(x, scan, live, o); }, opt, callback);
+  return run([&](const Entry& x, RegistrationOptions& o) { return live_call(x, scan, live, o); }, opt, callback);
 }
 
 const PreparedScene& RegistrationEngine::prepared_for(const RegistrationOptions& opt, const RegistrationResult& r) {
@@ -447,8 +443,7 @@ std::optional<RegistrationResult> RegistrationEngine::discretisation_reference(E
 
 RegistrationEngine::Entry& RegistrationEngine::nominal_entry(const RegistrationOptions& opt,
                                                              const RegistrationResult& nominal) {
-  Entry& e = entry(opt);
-  return nominal.volume_form_fallback ? fallback_entry(e, opt) : e;
+  return nominal.volume_form_fallback ? fallback_entry(opt) : entry(opt);
 }
 
 int RegistrationEngine::solvers_built() const {

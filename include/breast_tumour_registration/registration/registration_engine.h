@@ -129,15 +129,15 @@ class RegistrationEngine {
   std::optional<RegistrationResult> discretisation_reference(Entry& e, const Scene& scene, const RegistrationOptions& opt,
                                                              const RegistrationResult& nominal,
                                                              std::vector<std::string>& notes);
-  /// Where a nodal registration on e falls back to the element form: the preset's element mesh
-  /// where the preset chose the nodal form (entry(opt) with the scene's own form), else e's twin
-  Entry& fallback_entry(Entry& e, const RegistrationOptions& opt);
+  /// Where a nodal registration on entry(opt) falls back to the element form: the preset's element
+  /// mesh where the preset chose the nodal form (entry(opt) with the scene's own form), else
+  /// entry(opt)'s element twin
+  Entry& fallback_entry(const RegistrationOptions& opt);
   int prepared_entries() const;  ///< entries and twins
   /// The entry `nominal` was computed on: entry(opt), or its fallback_entry where it fell back
   Entry& nominal_entry(const RegistrationOptions& opt, const RegistrationResult& nominal);
-  /// Registers on e the supine scene supine_for makes; falls back as solve() says
-  RegistrationResult run(Entry& e, const SupineFor& supine_for, const RegistrationOptions& opt,
-                         const StepCallback& callback);
+  /// Registers on entry(opt) the supine scene supine_for makes; falls back as solve() says
+  RegistrationResult run(const SupineFor& supine_for, const RegistrationOptions& opt, const StepCallback& callback);
   /// The scene of a live scan on `e`'s prepared scene; `opt` takes the tracked pose it decides
   /// and that pose's covariance (solve_live and sample_uncertainty_live alike).
   static Scene live_call(const Entry& e, const LiveScan& scan, const LiveSceneOptions& live, RegistrationOptions& opt);
