@@ -61,6 +61,10 @@ Json step_report(const StepReport& s) {
               {"projection", num(s.t_projection)}}},
             {"factorizations", s.factorizations},
             {"pcg_iterations", s.pcg_iterations}};
+  if (s.free_limit_checked_at > 0)
+    j["free_limit_check"] = {{"projection", s.free_limit_checked_at},
+                             {"distance_mm", num(s.free_limit_distance * 1e3)},
+                             {"beyond_tolerance", s.free_limit_missed}};
   if (s.name == "unload")
     j["unload"] = {{"resimulated_prone_mismatch_mm", num(s.unload.mismatch * 1e3)},
                    {"rest_shape_change_mm", num(s.unload.rest_change * 1e3)},

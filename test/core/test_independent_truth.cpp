@@ -117,15 +117,27 @@ TEST(SurfaceStep, HeldSlidingConvergesWhereFreeSlidingCreepsAndEndsNoFartherFrom
   EXPECT_LE(worst_error(held), worst_error(free) + 0.1e-3);
 }
 
-TEST(SurfaceStep, HeldSlidingChangesNothingWhereFreeSlidingContractsQuickly) {
-  // The method told the body's own fat modulus: the alternation contracts fast, the skin's
-  // sliding is never held, and both options give the same answer.
+TEST(SurfaceStep, HeldSlidingKeepsTheSettledStateWhereTheFreeLimitLiesFarther) {
+  // The method told the body's own fat modulus. After 4 projections the steps read a fast
+  // contraction (0.34) and a skin settled within the tolerance, but the free limit (checked by
+  // one Newton step without the point springs: verify_free_limit) lies 0.22 mm RMS away. Free
+  // sliding goes on to it (35 projections); HeldWhereSettled holds the sliding where the steps
+  // settled and converges there. Before the check both stopped at projection 4, "converged".
+  // On this independent truth the held state is the nearer one (0.55 against 0.74 mm).
   const RegistrationResult free = register_sliding(3400, SkinSliding::Free);
   const RegistrationResult held = register_sliding(3400, SkinSliding::HeldWhereSettled);
+  const StepReport &fs = free.reports.back(), &hs = held.reports.back();
   EXPECT_TRUE(free.converged) << step_stops(free);
-  EXPECT_EQ(held.reports.back().sliding_held_from, 0) << step_stops(held);
-  EXPECT_EQ(held.reports.back().outer_iterations, free.reports.back().outer_iterations);
-  EXPECT_NEAR(worst_error(held), worst_error(free), 1e-9);
+  EXPECT_TRUE(held.converged) << step_stops(held);
+  EXPECT_TRUE(fs.free_limit_missed && hs.free_limit_missed);
+  EXPECT_EQ(fs.sliding_held_from, 0);
+  EXPECT_GT(hs.sliding_held_from, 0);
+  EXPECT_EQ(hs.sliding_held_from, hs.free_limit_checked_at);
+  EXPECT_GT(fs.outer_iterations, hs.outer_iterations);
+  EXPECT_LE(worst_error(held), worst_error(free) + 0.1e-3);
+  std::printf("SfePy body, method at 3400 Pa: free sliding to its limit in %d projections, worst %.3f mm; held from %d, "
+              "converged after %d, worst %.3f mm\n",
+              fs.outer_iterations, worst_error(free) * 1e3, hs.sliding_held_from, hs.outer_iterations, worst_error(held) * 1e3);
 }
 
 TEST(SurfaceStep, NoisyLandmarksOnANoisyScanNoLongerFoldTheSkinBesideThem) {

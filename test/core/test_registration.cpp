@@ -1029,6 +1029,106 @@ TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
               worst_error(moved) * 1e3, worst_error(told) * 1e3);
 }
 
+// The 12 mm phantom made at 600 Pa without its chest ring, registered at the true E from the
+// unloaded rest shape (`prone_gravity`, the element form of its truth): the model is right, so
+// the pose-free limit is the truth. Writes unload_free / unload_told / unload_misaligned /
+// prone_free.yaml (the last: the prone shape as rest) and returns the folder.
+std::string ring_free_unloaded_dir() {
+  static const std::string dir = [] {
+    const std::string d = soft_phantom_dir("phantom12_soft_ringfree");
+    std::string text, line;
+    std::istringstream is(without_key(without_key(phantom_scene_text(d), "material"), "steps"));
+    while (std::getline(is, line))
+      if (line.find("chest_ring:") == std::string::npos) text += line + "\n";
+    text += "material: {youngs_modulus: 600, poisson_ratio: 0.49, density: 1000, volume_form: element}\nprone_gravity: [0, 0, 9.81]\n";
+    btr::test::write_text(d + "/unload_free.yaml", text + "steps: auto\n");
+    btr::test::write_text(d + "/unload_told.yaml", text + "steps: [unload, landmarks, surface]\n");
+    btr::test::write_text(d + "/unload_misaligned.yaml",
+                          text + "steps: auto\nmisalignment: {rotation_deg: [15, 0, 0], translation_mm: [0, 0, 10]}\n");
+    btr::test::write_text(d + "/prone_free.yaml", without_key(text, "prone_gravity") + "steps: auto\n");
+    return d;
+  }();
+  return dir;
+}
+
+// Options that run the surface step's alternation to its free limit (no hold: the tolerance is
+// never first met, so nothing settles early).
+RegistrationOptions to_the_free_limit(RegistrationOptions o) {
+  o.surface.projection_tolerance = 1e-10;
+  o.surface.max_projections = 2000;
+  o.surface.stall_projections = 2000;
+  return o;
+}
+
+// Issue 10's 0.05 mm bound at the soft end. With the prone shape as the rest shape a free pose
+// absorbs part of the model's missing sag (bench/run_ringfree.sh: 6.9 against 0.58 mm at 400 Pa);
+// with the rest shape unloaded the model is right, and the pose-free limit is where the same
+// steps told the pose end, aligned or misaligned by 15 deg / 10 mm. The balanced preset stops
+// short of that limit (a slow slide of the skin and the pose together, held where the check
+// finds it: SurfaceStep.ASlowSlideTheStepsMissIsFoundAndHeld): 0.17 mm, where told it is 0.004.
+TEST(RingFree, WithTheUnloadedRestShapeAFreePoseEndsWhereTheToldPoseDoes) {
+  const std::string dir = ring_free_unloaded_dir();
+  const RegistrationResult aligned = register_scene(dir + "/unload_free.yaml");
+  const RegistrationResult moved = register_scene(dir + "/unload_misaligned.yaml");
+  const RegistrationResult prone = register_scene(dir + "/prone_free.yaml");
+  const RegistrationOptions tight = to_the_free_limit(preset_options("balanced"));
+  const RegistrationResult limit = register_scene(dir + "/unload_free.yaml", tight);
+  const RegistrationResult told = register_scene(dir + "/unload_told.yaml", tight);
+  ASSERT_FALSE(aligned.reports.empty());
+  EXPECT_EQ(aligned.reports.front().name, "unload");
+  EXPECT_TRUE(aligned.pose_solved_with_surface && !aligned.icp_used && !told.pose_solved_with_surface);
+  EXPECT_TRUE(aligned.converged && moved.converged && limit.converged && told.converged);
+  ASSERT_EQ(aligned.tumours.size(), moved.tumours.size());
+  for (size_t i = 0; i < aligned.tumours.size(); ++i)
+    EXPECT_LT(std::abs(aligned.tumours[i].centroid_distance - moved.tumours[i].centroid_distance), 0.05e-3);
+  EXPECT_LT(std::abs(worst_error(limit) - worst_error(told)), 0.05e-3) << worst_error(limit) * 1e3 << " vs " << worst_error(told) * 1e3;
+  EXPECT_LT(rotation_angle(limit.supine_to_model), 0.05 * M_PI / 180);  // the truth's pose: identity
+  EXPECT_LT(limit.supine_to_model.translation().norm(), 0.02e-3);
+  // What the bound guards: the prone shape as rest, pose free, ends far from both.
+  EXPECT_GT(worst_error(prone), worst_error(aligned) + 0.3e-3);
+  std::printf("ring-free phantom at 600 Pa, unloaded, pose free: balanced %.3f mm (misaligned %.3f), its limit %.3f mm; "
+              "told the pose %.3f mm; prone shape as rest %.3f mm\n",
+              worst_error(aligned) * 1e3, worst_error(moved) * 1e3, worst_error(limit) * 1e3, worst_error(told) * 1e3,
+              worst_error(prone) * 1e3);
+}
+
+// Issue 10, "converged means the criterion held": on that scene the balanced preset's steps
+// read the free skin as 0.081 mm from its limit (contraction 0.72) while it was 0.16 mm RMS away,
+// a slow slide of skin and pose under the faster modes. The check (one Newton step without the
+// point springs) must read the distance and hold the sliding there.
+TEST(SurfaceStep, ASlowSlideTheStepsMissIsFoundAndHeld) {
+  const std::string path = ring_free_unloaded_dir() + "/unload_free.yaml";
+  const Scene s = load_meshed_scene(path);
+  std::vector<std::string> warnings;
+  const RegistrationModel m = prepare_model(s, warnings);
+  RegistrationOptions unchecked = preset_options("balanced");
+  unchecked.surface.verify_free_limit = false;
+  const RegistrationResult before = run_registration(s, m, unchecked);
+  const RegistrationResult checked = run_registration(s, m, preset_options("balanced"));
+  const RegistrationResult limit = run_registration(s, m, to_the_free_limit(preset_options("balanced")));
+  auto skin_rms = [&](const Points& a, const Points& b) {
+    double sum = 0;
+    for (int v : m.skin) sum += (a.row(v) - b.row(v)).squaredNorm();
+    return std::sqrt(sum / static_cast<double>(m.skin.size()));
+  };
+  const StepReport& b = before.reports.back();
+  const StepReport& c = checked.reports.back();
+  ASSERT_EQ(b.name, "surface (pose free)");
+  const double missed = skin_rms(before.x, limit.x);
+  // Without the check: "settled", with the distance under-read by half or more.
+  EXPECT_TRUE(b.converged && b.sliding_held_from == 0 && b.free_limit_checked_at == 0);
+  EXPECT_LT(b.fixed_point_distance, 0.6 * missed) << b.fixed_point_distance * 1e3 << " vs " << missed * 1e3 << " mm";
+  EXPECT_GT(missed, unchecked.surface.projection_tolerance);
+  // With it: the distance read within 30 %, the sliding held there, and the held alternation converged.
+  EXPECT_TRUE(c.free_limit_missed);
+  EXPECT_NEAR(c.free_limit_distance, skin_rms(before.x, limit.x), 0.3 * missed);
+  EXPECT_EQ(c.sliding_held_from, c.free_limit_checked_at);
+  EXPECT_TRUE(c.converged) << c.stop_reason;
+  EXPECT_NE(c.stop_reason.find("free limit lay"), std::string::npos) << c.stop_reason;
+  std::printf("read %.3f mm from the limit by the steps, %.3f mm by the check; %.3f mm RMS in fact\n", b.fixed_point_distance * 1e3,
+              c.free_limit_distance * 1e3, missed * 1e3);
+}
+
 TEST(SurfaceStep, OptionsOutOfRangeAreNamed) {
   const Scene& s = test::coarse_phantom_scene();
   std::vector<std::string> warnings;

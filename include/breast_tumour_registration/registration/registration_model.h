@@ -38,6 +38,14 @@ struct StepReport {
   /// surface step: the projection from which the skin's sliding along the scan was held where
   /// it settled (SkinSliding::HeldWhereSettled; 0: free throughout)
   int sliding_held_from = 0;
+  /// surface step: where the steps read a freely sliding skin as settled, the RMS distance [m] to
+  /// the free limit that one Newton step without the point springs gives (SurfaceStepOptions::
+  /// verify_free_limit), the projection it was checked at, and whether it lay beyond the
+  /// tolerance (the steps had missed a slow slide; then that check's figures are kept). 0 / 0 /
+  /// false: not checked.
+  double free_limit_distance = 0;
+  int free_limit_checked_at = 0;
+  bool free_limit_missed = false;
   /// surface step: the held skin's RMS motion [m] at each projection, in order (how the
   /// alternation converged, stalled or jittered)
   std::vector<double> projection_residuals;
