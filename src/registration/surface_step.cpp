@@ -174,34 +174,34 @@ StepReport surface_step(const RegistrationModel& model, const SurfaceProjector& 
   // without them (elastic, gravity, point-to-plane springs on these projections and, with a free
   // pose, the landmarks) is stationary; one Newton step on that energy from xs goes most of the
   // way. The steps alone can miss a slow mode under a faster one (verify_free_limit).
+  // That energy shares the step's elastic and gravity terms; only its springs are its own,
+  // filled with the last projection's correspondences at each check.
+  TotalEnergy limit;
+  for (const auto& term : energy.terms())
+    if (term != springs && term != free_springs) limit.add(term);
+  auto limit_springs = std::make_shared<SpringEnergy>("skin to supine surface");
+  auto limit_free_springs = std::make_shared<RigidFreeSurfaceEnergy>(0.0, opt.plane_weight);
+  if (pose) {
+    if (pose_points) limit_free_springs->set_points(pose_points->anchors, pose_points->targets, opt.pose_points_weight);
+    limit.add(limit_free_springs);
+  } else {
+    limit.add(limit_springs);
+  }
   auto free_limit_distance = [&](const Points& xs) {
-    TotalEnergy limit;
-    add_model_elastic_energy(limit, model);
-    if (opt.gravity) limit.add(gravity);
     const Eigen::Index kept = static_cast<Eigen::Index>(held_verts.size());
     if (pose) {
-      auto f = std::make_shared<RigidFreeSurfaceEnergy>(0.0, opt.plane_weight);
-      if (pose_points) f->set_points(pose_points->anchors, pose_points->targets, opt.pose_points_weight);
-      f->set(held_verts, held_y.topRows(kept), held_n.topRows(kept));
-      limit.add(f);
+      limit_free_springs->set(held_verts, held_y.topRows(kept), held_n.topRows(kept));
     } else {
-      auto f = std::make_shared<SpringEnergy>("skin to supine surface");
+      limit_springs->clear();
       for (Eigen::Index k = 0; k < kept; ++k)
-        f->add_point_and_plane(Anchor::vertex(held_verts[static_cast<size_t>(k)]), Vec3(held_y.row(k).transpose()),
-                               Vec3(held_n.row(k).transpose()), 0.0, opt.plane_weight);
-      limit.add(f);
+        limit_springs->add_point_and_plane(Anchor::vertex(held_verts[static_cast<size_t>(k)]), Vec3(held_y.row(k).transpose()),
+                                           Vec3(held_n.row(k).transpose()), 0.0, opt.plane_weight);
     }
     Points y = xs;
     NewtonOptions o = nopt;
     o.max_iterations = 1;
     o.callback = {};
-    const NewtonResult lr = solver.solve(limit, y, o);
-    rep.t_assembly += lr.t_assembly;  // its time only: the step's inversion counts are the alternation's
-    rep.t_factorization += lr.t_factorization;
-    rep.t_solve += lr.t_solve;
-    rep.t_line_search += lr.t_line_search;
-    rep.factorizations += lr.factorizations;
-    rep.pcg_iterations += lr.pcg_iterations;
+    rep.add_newton_times(solver.solve(limit, y, o));  // not its inversion counts: those are the alternation's
     return held_change(y, xs).first;
   };
   for (int outer = 1; outer <= opt.max_projections; ++outer) {

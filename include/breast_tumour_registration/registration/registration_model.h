@@ -73,6 +73,10 @@ struct StepReport {
   void add_newton_profile(const NewtonResult& r) {
     inverted = r.inverted;
     inversions_allowed = inversions_allowed || r.inversions_allowed;
+    add_newton_times(r);
+  }
+  /// A solve's times and counts only (a side solve whose inversions are not the step's).
+  void add_newton_times(const NewtonResult& r) {
     t_assembly += r.t_assembly;
     t_factorization += r.t_factorization;
     t_solve += r.t_solve;
