@@ -17,6 +17,7 @@
 using namespace btr;
 using btr::test::expect_throw_with;
 using btr::test::scene_text;
+using btr::test::without_chest_ring;
 using btr::test::write_text;
 
 namespace {
@@ -30,10 +31,7 @@ std::string coarse_phantom_at(double e, const std::string& prefix, ElementOrder 
 /// The scene in folder d with `youngs_modulus: estimate` and the prone gravity (the model is
 /// unloaded at the estimate), written as d/name.yaml; `keep_ring` false drops the chest ring.
 Scene estimating_scene(const std::string& d, const std::string& name, bool keep_ring) {
-  std::string text, line;
-  std::istringstream is(scene_text(d));
-  while (std::getline(is, line))
-    if (keep_ring || line.find("chest_ring:") == std::string::npos) text += line + "\n";
+  std::string text = keep_ring ? scene_text(d) : without_chest_ring(scene_text(d));
   const std::string told = "material:\n  youngs_modulus: 3400\n";
   const size_t at = text.find(told);
   if (at == std::string::npos) throw std::runtime_error(d + ": no 'youngs_modulus: 3400' to replace");

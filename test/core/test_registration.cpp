@@ -1002,10 +1002,7 @@ TEST(Landmarks, DuplicatesAreMergedAndHandlesCapped) {
 // result, and the aligned scan must stay close to `steps: [landmarks, surface]` (which is
 // told the pose). BENCHMARKS.md has the finer phantom across moduli.
 TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
-  std::string text, line;
-  std::istringstream is(phantom_scene_text());
-  while (std::getline(is, line))
-    if (line.find("chest_ring:") == std::string::npos) text += line + "\n";
+  const std::string text = btr::test::without_chest_ring(phantom_scene_text());
   const std::string dir = phantom_dir();
   btr::test::write_text(dir + "/ring_free.yaml", text);
   btr::test::write_text(dir + "/ring_free_told.yaml", text + "steps: [landmarks, surface]\n");
@@ -1036,10 +1033,7 @@ TEST(RingFree, PoseSolvedWithTheDeformationIgnoresMisalignment) {
 std::string ring_free_unloaded_dir() {
   static const std::string dir = [] {
     const std::string d = soft_phantom_dir("phantom12_soft_ringfree");
-    std::string text, line;
-    std::istringstream is(without_key(without_key(phantom_scene_text(d), "material"), "steps"));
-    while (std::getline(is, line))
-      if (line.find("chest_ring:") == std::string::npos) text += line + "\n";
+    std::string text = btr::test::without_chest_ring(without_key(without_key(phantom_scene_text(d), "material"), "steps"));
     text += "material: {youngs_modulus: 600, poisson_ratio: 0.49, density: 1000, volume_form: element}\nprone_gravity: [0, 0, 9.81]\n";
     btr::test::write_text(d + "/unload_free.yaml", text + "steps: auto\n");
     btr::test::write_text(d + "/unload_told.yaml", text + "steps: [unload, landmarks, surface]\n");

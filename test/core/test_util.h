@@ -108,6 +108,16 @@ inline std::string without_key(const std::string& text, const std::string& key) 
   return out;
 }
 
+/// A phantom scene's text without its chest rings (the `chest_ring:` lines, top level and under
+/// `supine`): no rigid region, so the pose is solved with the deformation.
+inline std::string without_chest_ring(const std::string& text) {
+  std::istringstream is(text);
+  std::string out, l;
+  while (std::getline(is, l))
+    if (l.find("chest_ring:") == std::string::npos) out += l + "\n";
+  return out;
+}
+
 /// Runs f and expects it to throw E whose message contains `needle`.
 template <class E, class F>
 void expect_throw_with(F&& f, const std::string& needle) {
