@@ -309,20 +309,8 @@ StiffnessEstimate estimate_stiffness(const RegistrationModel& model, const Vec3&
   // with them, from the linear one: on SfePy's second body at fat 1000 Pa a search with quadratic
   // candidates chose 972 Pa where the linear one chose 968, at 25 times the time (BENCHMARKS.md,
   // "A quadratic forward model for the unload").
-  if (model.material.unload_element_order != ElementOrder::Linear) {
-    UnloadProblem pb = unload_problem(model, prone, prone_gravity / est.scale);
-    pb.initial_rest = &c_best.rest;
-    UnloadResult q = estimate_unloaded_shape(pb, with_model_elements(opt.unload, model));
-    if (q.converged || q.max_mismatch < c_best.unload.max_mismatch) {
-      q.seconds += c_best.unload.seconds;
-      q.stop_reason += " (" + std::string(to_string(model.material.unload_element_order)) + " elements)";
-      c_best.unload = std::move(q);
-      c_best.rest = c_best.unload.rest;
-    } else {
-      c_best.unload.stop_reason += "; with " + std::string(to_string(model.material.unload_element_order)) +
-                                   " elements it did not converge (" + q.stop_reason + "), so the linear shape is used";
-    }
-  }
+  refine_with_model_elements(model, prone, prone_gravity / est.scale, opt.unload, c_best.unload);
+  c_best.rest = c_best.unload.rest;
   est.misfit = c_best.misfit;
   est.landmarks = static_cast<int>(anchors.size());
   est.landmark_sensitivity = residual_slope(residuals, u_best);

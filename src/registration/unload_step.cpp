@@ -51,15 +51,38 @@ UnloadOptions with_model_elements(UnloadOptions options, const RegistrationModel
   return options;
 }
 
+void refine_with_model_elements(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity,
+                                const UnloadOptions& options, UnloadResult& unload) {
+  if (model.material.unload_element_order == ElementOrder::Linear) return;
+  UnloadProblem pb = unload_problem(model, loaded, gravity);
+  pb.initial_rest = &unload.rest;
+  UnloadOptions o = with_model_elements(options, model);
+  o.max_forward_solves = kModelElementsForwardSolves;
+  o.max_stages = 0;  // from the linear shape it converges directly where it converges at all (below)
+  UnloadResult q = estimate_unloaded_shape(pb, o);
+  const std::string order = to_string(model.material.unload_element_order);
+  q.seconds += unload.seconds;
+  if (q.converged || q.max_mismatch < unload.max_mismatch) {
+    q.stop_reason += " (" + order + " elements, from the linear shape)";
+    unload = std::move(q);
+  } else {
+    unload.seconds = q.seconds;
+    unload.stop_reason += "; with " + order + " elements it did not converge (" + q.stop_reason + "), so the linear shape is used";
+  }
+}
+
 StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options,
                         StepSolvers* cache) {
   if (!prone_gravity.allFinite() || !(prone_gravity.norm() > 0))
     throw InputError("prone_gravity: must be a finite, non-zero vector [m/s^2]");
   const TetMesh loaded{model.prone, model.rest.T};
   UnloadProblem pb = unload_problem(model, loaded, prone_gravity);
-  // Quadratic elements build their own solver (another pattern): the linear one is not asked for.
-  if (cache && model.material.unload_element_order == ElementOrder::Linear) pb.solver = &cache->gravity(model);
-  const UnloadResult u = estimate_unloaded_shape(pb, with_model_elements(options, model));
+  if (cache) pb.solver = &cache->gravity(model);
+  // With linear elements first; quadratic ones (another solver, another pattern) start from there.
+  UnloadOptions linear = options;
+  linear.forward.element_order = ElementOrder::Linear;
+  UnloadResult u = estimate_unloaded_shape(pb, linear);
+  if (u.converged) refine_with_model_elements(model, loaded, prone_gravity, options, u);
 
   StepReport rep = unload_report(u, model.prone);
   // The prone shape as rest misses the prone shape by about the sag; the estimate is kept when

@@ -21,7 +21,7 @@ struct MaterialParameters {
   /// registration steps stay linear, and the stiffness search compares its candidates with
   /// linear elements, then unloads the chosen E with these). Quadratic: measured against SfePy's
   /// cubic truth (BENCHMARKS.md, "A quadratic forward model for the unload"), at several times
-  /// the unload's cost.
+  /// the unload's cost. The quadratic shape is found from the linear one (unload_step.h).
   ElementOrder unload_element_order = ElementOrder::Linear;
 };
 
