@@ -18,8 +18,10 @@ class StepSolvers;
 /// only when re-simulating from it reproduces the prone shape better than the prone shape as
 /// rest would (its mismatch is below the prone sag the inverse-gravity solve measured);
 /// otherwise the prone shape stays the rest shape. Either way the report says not converged,
-/// and its note says which shape was kept. `cache`: an engine's solvers, whose gravity solver
-/// (its symbolic analysis) the forward solves reuse; null: they build their own.
+/// and its note says which shape was kept. With quadratic elements
+/// (MaterialParameters::unload_element_order) the linear shape is found first and refined
+/// (refine_with_model_elements). `cache`: an engine's solvers, whose gravity solver (its
+/// symbolic analysis) the linear forward solves reuse; null: they build their own.
 StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options = {},
                         StepSolvers* cache = nullptr);
 
@@ -39,9 +41,9 @@ constexpr int kModelElementsForwardSolves = 12;
 /// Where `model` unloads with quadratic elements (MaterialParameters::unload_element_order):
 /// `unload` (an unloaded shape of `loaded` under `gravity` found with linear elements) is found
 /// again with them, starting from it, within kModelElementsForwardSolves forward solves and
-/// without load continuation. Their
-/// estimate replaces it where it converged or reproduces the prone shape better; otherwise the
-/// linear shape stays and its stop reason says why. With linear elements, nothing to do.
+/// without load continuation. Their estimate replaces it where it converged or reproduces the
+/// prone shape better; otherwise the linear shape stays and its stop reason says why. With linear
+/// elements, nothing to do.
 void refine_with_model_elements(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity,
                                 const UnloadOptions& options, UnloadResult& unload);
 
