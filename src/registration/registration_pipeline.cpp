@@ -341,8 +341,8 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       }
       if (u.rest_shape_follows) {
         char b[160];
-        std::snprintf(b, sizeof b, "the unloaded rest shape moves with E and Poisson's ratio (%d GMRES products, %.2f s)",
-                      u.rest_response_iterations, u.rest_response_seconds);
+        std::snprintf(b, sizeof b, "the unloaded rest shape moves with E and Poisson's ratio (%s unload's equation: %d GMRES products, %.2f s)",
+                      to_string(model.material.unload_element_order), u.rest_response_iterations, u.rest_response_seconds);
         notes.push_back(b);
       }
       if (!u.note.empty()) notes.push_back(u.note);

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -22,6 +23,7 @@
 #include "breast_tumour_registration/fem/total_energy.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/registration/quadratic_unload_equation.h"
 
 namespace btr {
 namespace {
@@ -123,21 +125,28 @@ struct RestResponse {
   bool converged = true;
 };
 
+using VertexMap = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;  ///< every vertex to every vertex
+
+/// d_rest: products with D_X G_p (every vertex); precondition: an approximate inverse of it
+/// (every vertex), or empty for minus the inverse of the prone elastic Hessian.
 RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& elastic,
-                                 const std::vector<Eigen::VectorXd>& dGp_dp) {
+                                 const std::vector<Eigen::VectorXd>& dGp_dp, const VertexMap& d_rest,
+                                 const VertexMap& precondition = {}) {
   const int nv = static_cast<int>(m.rest.V.rows());
   HessianAssembler Hp(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
   Llt llt;  // only the preconditioner: the projected one serves too
-  factorize_exact_or_projected(elastic, m.prone, Hp, llt, "the prone Hessian");
+  if (!precondition) factorize_exact_or_projected(elastic, m.prone, Hp, llt, "the prone Hessian");
   auto scatter = [&](const Eigen::VectorXd& reduced) {
     Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
     Hp.scatter_add(reduced, 1.0, full);
     return full;
   };
   auto apply_A = [&](const Eigen::VectorXd& v) {
-    return Eigen::VectorXd(Hp.gather(gradient_d_rest(m, m.prone, scatter(v), m.unloaded_under)));
+    return Eigen::VectorXd(Hp.gather(d_rest(scatter(v))));
   };
-  auto apply_Minv = [&](const Eigen::VectorXd& r) { return Eigen::VectorXd(-llt.solve(r)); };
+  auto apply_Minv = [&](const Eigen::VectorXd& r) {
+    return precondition ? Eigen::VectorXd(Hp.gather(precondition(scatter(r)))) : Eigen::VectorXd(-llt.solve(r));
+  };
   RestResponse out;
   for (const Eigen::VectorXd& b : dGp_dp) {
     Eigen::VectorXd y;
@@ -151,11 +160,18 @@ RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& 
 }
 
 /// The unloaded rest shape's response to ln E and (with_q) to q: the prone gradient's partials
-/// at the imaged shape (dG_p/d ln E = G_elastic there), the q column zero without q.
+/// at the imaged shape (dG_p/d ln E = G_elastic there), the q column zero without q. Where the
+/// model unloaded with quadratic elements, their equation's (quadratic_unload_equation.h).
 RestResponse rest_response_to_material(const RegistrationModel& m, const TotalEnergy& elastic, bool with_q) {
-  return rest_shape_response(m, elastic,
-                             {elastic.gradient(m.prone), with_q ? elastic_gradient_d_compliance(m, m.prone)
-                                                                : Eigen::VectorXd::Zero(3 * m.rest.V.rows())});
+  const Eigen::VectorXd none = Eigen::VectorXd::Zero(3 * m.rest.V.rows());
+  if (m.material.unload_element_order == ElementOrder::Quadratic) {
+    const QuadraticUnloadEquation eq(m);
+    return rest_shape_response(m, elastic, {eq.d_log_youngs_modulus(), with_q ? eq.d_compliance() : none},
+                               [&](const Eigen::VectorXd& v) { return eq.d_rest(v); },
+                               [&](const Eigen::VectorXd& r) { return eq.precondition(r); });
+  }
+  return rest_shape_response(m, elastic, {elastic.gradient(m.prone), with_q ? elastic_gradient_d_compliance(m, m.prone) : none},
+                             [&](const Eigen::VectorXd& v) { return gradient_d_rest(m, m.prone, v, m.unloaded_under); });
 }
 
 bool fit_usable(const LandmarkStiffnessFit& fit, int nv) {

@@ -456,9 +456,11 @@ TEST(Uncertainty, AFreePoseAndItsLandmarksAreLinearisedAsTheirEnergyReSolves) {
 // and the held energy re-solved: the linearised sensitivities (the rest shape's response from
 // the unload's own equation, by GMRES) must match, and must differ from the response with the
 // rest shape held (else this test could not see the rest shape's part).
-TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFollowsIt) {
+namespace {
+void expect_the_linearisation_follows_the_unloaded_rest_shape(ElementOrder unload_elements) {
   Scene s = btr::test::coarse_phantom_scene();
   s.prone_gravity = Vec3(0, 0, 9.81);  // the phantom's prone gravity (its scene's `frame`)
+  s.material.unload_element_order = unload_elements;
   RegistrationOptions o = preset_options("balanced");
   o.uncertainty.enabled = true;
   o.uncertainty.held_projections = true;
@@ -486,6 +488,7 @@ TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFoll
       UnloadProblem pb = unload_problem(m, loaded, model.unloaded_under);
       pb.initial_rest = &model.rest.V;
       UnloadOptions uo;
+      uo.forward.element_order = unload_elements;
       uo.tolerance = 1e-9;
       uo.max_iterations = 80;
       uo.forward.newton.gradient_rel_tolerance = 1e-12;
@@ -521,6 +524,18 @@ TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFoll
     EXPECT_LT((u.d_volume_compliance - fd_q).norm(), 0.05 * fd_q.norm()) << r.tumours[i].name;
     EXPECT_GT((fd_e - held_e).norm(), 0.2 * fd_e.norm()) << r.tumours[i].name << ": the rest shape's part is not seen";
   }
+}
+}  // namespace
+
+TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFollowsIt) {
+  expect_the_linearisation_follows_the_unloaded_rest_shape(ElementOrder::Linear);
+}
+
+// With quadratic elements the unload solves another equation (its edge nodes balanced at the
+// imaged corners: quadratic_unload_equation.h); the linear unload's response was 30 to 40 % off
+// the re-solves here.
+TEST(Uncertainty, AQuadraticallyUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFollowsIt) {
+  expect_the_linearisation_follows_the_unloaded_rest_shape(ElementOrder::Quadratic);
 }
 
 // Where E is estimated from the landmarks, a true Poisson's ratio other than the method's moves
