@@ -39,6 +39,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   ForwardGravity phi(loaded.T, nv, pb.fixed, pb.materials, pb.material_of, pb.volume_form, pb.nodal_element_share,
                      pb.density, opt.forward, pb.solver);
   UnloadResult res;
+  res.elements = opt.forward.element_order;
   int first = 0;  // Newton iterations of the first converged forward solve: the cost unit
   const std::string budget_spent = "forward-solve budget (" + std::to_string(opt.max_forward_solves) + ") spent";
   auto spent = [&] { return opt.max_forward_solves > 0 && res.iterations >= opt.max_forward_solves; };

@@ -342,7 +342,7 @@ RegistrationResult run_registration(const Scene& scene, const RegistrationModel&
       if (u.rest_shape_follows) {
         char b[160];
         std::snprintf(b, sizeof b, "the unloaded rest shape moves with E and Poisson's ratio (%s unload's equation: %d GMRES products, %.2f s)",
-                      to_string(model.material.unload_element_order), u.rest_response_iterations, u.rest_response_seconds);
+                      to_string(model.unload ? model.unload->unload.elements : ElementOrder::Linear), u.rest_response_iterations, u.rest_response_seconds);
         notes.push_back(b);
       }
       if (!u.note.empty()) notes.push_back(u.note);

@@ -161,10 +161,11 @@ RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& 
 
 /// The unloaded rest shape's response to ln E and (with_q) to q: the prone gradient's partials
 /// at the imaged shape (dG_p/d ln E = G_elastic there), the q column zero without q. Where the
-/// model unloaded with quadratic elements, their equation's (quadratic_unload_equation.h).
+/// rest shape inverts the quadratic model (its quadratic pass converged), that equation's
+/// (quadratic_unload_equation.h); where that pass kept the linear shape, the linear one's.
 RestResponse rest_response_to_material(const RegistrationModel& m, const TotalEnergy& elastic, bool with_q) {
   const Eigen::VectorXd none = Eigen::VectorXd::Zero(3 * m.rest.V.rows());
-  if (m.material.unload_element_order == ElementOrder::Quadratic) {
+  if (m.unload && m.unload->unload.elements == ElementOrder::Quadratic) {
     const QuadraticUnloadEquation eq(m);
     return rest_shape_response(m, elastic, {eq.d_log_youngs_modulus(), with_q ? eq.d_compliance() : none},
                                [&](const Eigen::VectorXd& v) { return eq.d_rest(v); },

@@ -42,7 +42,7 @@ StepReport unload_report(const UnloadResult& u, const Points& prone) {
   rep.outer_iterations = u.iterations;
   rep.seconds = u.seconds;
   const double moved = u.rest.rows() == prone.rows() ? (u.rest - prone).rowwise().norm().maxCoeff() : 0.0;
-  rep.unload = {u.max_mismatch, u.forward_solve_equivalents, moved, u.load_steps};
+  rep.unload = {u.max_mismatch, u.forward_solve_equivalents, moved, u.load_steps, u.elements};
   return rep;
 }
 

@@ -71,6 +71,7 @@ Json step_report(const StepReport& s) {
                    {"forward_solves", s.outer_iterations},
                    {"forward_solve_equivalents", num(s.unload.forward_solve_equivalents)},
                    {"load_steps", s.unload.load_steps},
+                   {"elements", to_string(s.unload.elements)},  // whose forward model the rest shape inverts
                    {"note", s.note}};
   return j;
 }

@@ -331,6 +331,7 @@ TEST(Unload, AQuadraticPassThatDoesNotConvergeLeavesTheLinearShape) {
   UnloadResult kept = linear;
   refine_with_model_elements(m, loaded, g, starved, kept);
   EXPECT_TRUE(kept.converged);
+  EXPECT_EQ(kept.elements, ElementOrder::Linear);  // the linear region differentiates the linear unload then
   EXPECT_EQ((kept.rest - linear.rest).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_NE(kept.stop_reason.find("with quadratic elements it did not converge"), std::string::npos) << kept.stop_reason;
   EXPECT_NE(kept.stop_reason.find("so the linear shape is used"), std::string::npos) << kept.stop_reason;
@@ -339,6 +340,8 @@ TEST(Unload, AQuadraticPassThatDoesNotConvergeLeavesTheLinearShape) {
   UnloadResult refined = linear;
   refine_with_model_elements(m, loaded, g, UnloadOptions{}, refined);
   EXPECT_TRUE(refined.converged) << refined.stop_reason;
+  EXPECT_EQ(refined.elements, ElementOrder::Quadratic);
+  EXPECT_EQ(unload_report(refined, m.prone).unload.elements, ElementOrder::Quadratic);
   EXPECT_NE(refined.stop_reason.find("(quadratic elements, from the linear shape)"), std::string::npos) << refined.stop_reason;
   EXPECT_LE(refined.iterations, kModelElementsForwardSolves);
   EXPECT_GT((refined.rest - linear.rest).rowwise().norm().maxCoeff(), 1e-6);

@@ -43,6 +43,7 @@ struct UnloadOptions {
 
 struct UnloadResult {
   Points rest;          ///< the estimated stress-free positions (the fixed vertices keep x_p's)
+  ElementOrder elements = ElementOrder::Linear;  ///< of the forward model it inverts (options.forward.element_order)
   Points resimulated;   ///< phi(rest): the forward equilibrium from it
   bool converged = false;
   std::string stop_reason;

@@ -64,6 +64,7 @@ struct StepReport {
   struct UnloadFigures {
     double mismatch = 0, forward_solve_equivalents = 0, rest_change = 0;
     int load_steps = 0;
+    ElementOrder elements = ElementOrder::Linear;  ///< whose forward model the rest shape inverts
   } unload;
   /// stiffness step: the estimated Young's modulus [Pa] and the landmark misfit of its gravity-only prediction [m]
   double stiffness_youngs_modulus = 0, stiffness_misfit = 0;
