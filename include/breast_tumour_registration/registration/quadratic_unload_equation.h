@@ -15,6 +15,7 @@
 #include <Eigen/CholmodSupport>
 #include <memory>
 
+#include "breast_tumour_registration/fem/forward_gravity.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
@@ -27,7 +28,9 @@ class QuadraticUnloadEquation {
   /// At the model's rest shape (its unloaded corners) under model.unloaded_under, its corners at
   /// model.prone: balances the edge nodes (Newton). Throws SolverError where they cannot be
   /// balanced or their Hessian cannot be factorized, InputError on a model not unloaded.
-  explicit QuadraticUnloadEquation(const RegistrationModel& model, int quadrature_degree = 5);
+  /// quadrature_degree: the unload's forward model's (ForwardGravityOptions).
+  explicit QuadraticUnloadEquation(const RegistrationModel& model,
+                                   int quadrature_degree = ForwardGravityOptions{}.quadrature_degree);
   ~QuadraticUnloadEquation();
 
   /// D_X G [dX]: every vertex, 3 rows each (dX zero on the chest wall).
