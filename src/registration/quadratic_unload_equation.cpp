@@ -110,9 +110,8 @@ Eigen::VectorXd QuadraticUnloadEquation::d_log_youngs_modulus() const {
 
 Eigen::VectorXd QuadraticUnloadEquation::d_compliance() const {
   const double q0 = volume_compliance(model_.material.poisson_ratio), h = 1e-3 * q0;
-  auto nu_of = [](double q) { return 1.0 / (2.0 * (1.0 + q)); };
-  return (corner_gradient(model_.rest.V, scaled(model_.materials, 1.0, nu_of(q0 + h))) -
-          corner_gradient(model_.rest.V, scaled(model_.materials, 1.0, nu_of(q0 - h)))) /
+  return (corner_gradient(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 + h))) -
+          corner_gradient(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 - h)))) /
          (2 * h);
 }
 

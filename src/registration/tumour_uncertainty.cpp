@@ -94,9 +94,8 @@ Eigen::VectorXd body_gradient(const RegistrationModel& m, const Points& rest, co
 /// central difference in q kept inside (0, inf).
 Eigen::VectorXd elastic_gradient_d_compliance(const RegistrationModel& m, const Points& x) {
   const double q0 = volume_compliance(m.material.poisson_ratio), h = 1e-3 * q0;
-  auto nu_of = [](double q) { return 1.0 / (2.0 * (1.0 + q)); };
-  return (body_gradient(m, m.rest.V, materials_at(m, nu_of(q0 + h)), x, Vec3::Zero()) -
-          body_gradient(m, m.rest.V, materials_at(m, nu_of(q0 - h)), x, Vec3::Zero())) /
+  return (body_gradient(m, m.rest.V, materials_at(m, poisson_ratio_of_compliance(q0 + h)), x, Vec3::Zero()) -
+          body_gradient(m, m.rest.V, materials_at(m, poisson_ratio_of_compliance(q0 - h)), x, Vec3::Zero())) /
          (2 * h);
 }
 
@@ -232,6 +231,8 @@ double per_compliance(const LandmarkFitMotion& f) {
 }  // namespace
 
 double volume_compliance(double nu) { return (1.0 - 2.0 * nu) / (2.0 * nu); }
+
+double poisson_ratio_of_compliance(double q) { return 1.0 / (2.0 * (1.0 + q)); }
 
 double volume_compliance_rms(const std::array<double, 2>& range, double nominal_nu) {
   if (!(range[1] > 0)) return 0;

@@ -140,6 +140,8 @@ struct UncertaintyResult {
 /// The volume compliance q = mu / lambda_L = (1 - 2 nu) / (2 nu) of Poisson's ratio nu: the
 /// variable the linearisation takes Poisson's ratio in (0 at incompressibility).
 double volume_compliance(double nu);
+/// Its inverse: Poisson's ratio nu = 1 / (2 (1 + q)) of the volume compliance q.
+double poisson_ratio_of_compliance(double q);
 
 /// sqrt(E[(q(nu) - q(nominal_nu))^2]) for nu uniform over `range` (0 when the range is {0, 0}:
 /// held): the spread of the true compliance about the method's.
