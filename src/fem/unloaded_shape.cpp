@@ -62,6 +62,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   // The fixed point at `scale` x the imaging gravity from the first estimate X0, to `tolerance`.
   struct Stage {
     Points X, x;  // the best estimate and its equilibrium
+    Points nodes; // quadratic elements: every node of that equilibrium
     bool started = false, converged = false;
     double best = std::numeric_limits<double>::infinity();
     std::vector<double> history;
@@ -96,6 +97,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
         st.best = mismatch;
         st.X = X;
         st.x = x;
+        if (opt.forward.element_order == ElementOrder::Quadratic) st.nodes = phi.quadratic_nodes();  // x's solve was the last
       }
       if (mismatch < tolerance) {
         st.converged = true;
@@ -239,6 +241,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   } else {
     res.rest = result.X;
     res.resimulated = result.x;
+    res.quadratic = {result.nodes, phi.quadratic_solver()};
     res.max_mismatch = result.best;
   }
   res.forward_solve_equivalents = first > 0 ? static_cast<double>(res.newton_iterations) / first : 0.0;

@@ -25,7 +25,8 @@ class StiffnessStep : public RegistrationStep {
         estimate_stiffness(c.prepared(), *c.scene.prone_gravity, c.scene.landmark_anchors, c.scene.landmark_supine, so, c.solvers);
     RegistrationModel m = c.prepared();
     scale_stiffness(m, est.scale);
-    set_rest_shape(m, est.rest, unload_report(est.unload, c.prepared().prone), *c.scene.prone_gravity);
+    set_rest_shape(m, est.rest, unload_report(est.unload, c.prepared().prone), *c.scene.prone_gravity,
+                   est.unload.quadratic);
     c.use_estimated_model(std::move(m));
     StepReport rep;
     rep.name = name();

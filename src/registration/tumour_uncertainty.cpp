@@ -9,7 +9,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <functional>
 #include <memory>
 
 #include "breast_tumour_registration/base/errors.h"
@@ -117,43 +116,26 @@ Eigen::VectorXd gradient_d_rest(const RegistrationModel& m, const Points& x, con
 /// (gradient_d_rest). GMRES solves it, preconditioned by minus the prone elastic Hessian: for small
 /// strains moving the rest shape is moving the deformed one backwards, D_X G ~ -H, and the
 /// preconditioned operator is near the identity (this is the unload's fixed point, linearised).
-struct RestResponse {
-  std::vector<Eigen::VectorXd> dX;  ///< per input, every vertex (zero on the chest wall)
-  int iterations = 0;               ///< products with D_X G_p, over the inputs
-  double worst_residual = 0;        ///< the largest relative residual
-  bool converged = true;
-};
-
-using VertexMap = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;  ///< every vertex to every vertex
-
-/// d_rest: products with D_X G_p (every vertex); precondition: an approximate inverse of it
-/// (every vertex), or empty for minus the inverse of the prone elastic Hessian.
-RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& elastic,
-                                 const std::vector<Eigen::VectorXd>& dGp_dp, const VertexMap& d_rest,
-                                 const VertexMap& precondition = {}) {
+RestShapeResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& elastic,
+                                      const std::vector<Eigen::VectorXd>& dGp_dp) {
   const int nv = static_cast<int>(m.rest.V.rows());
   HessianAssembler Hp(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
   Llt llt;  // only the preconditioner: the projected one serves too
-  if (!precondition) factorize_exact_or_projected(elastic, m.prone, Hp, llt, "the prone Hessian");
+  factorize_exact_or_projected(elastic, m.prone, Hp, llt, "the prone Hessian");
   auto scatter = [&](const Eigen::VectorXd& reduced) {
     Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
     Hp.scatter_add(reduced, 1.0, full);
     return full;
   };
   auto apply_A = [&](const Eigen::VectorXd& v) {
-    return Eigen::VectorXd(Hp.gather(d_rest(scatter(v))));
+    return Eigen::VectorXd(Hp.gather(gradient_d_rest(m, m.prone, scatter(v), m.unloaded_under)));
   };
-  auto apply_Minv = [&](const Eigen::VectorXd& r) {
-    return precondition ? Eigen::VectorXd(Hp.gather(precondition(scatter(r)))) : Eigen::VectorXd(-llt.solve(r));
-  };
-  RestResponse out;
+  auto apply_Minv = [&](const Eigen::VectorXd& r) { return Eigen::VectorXd(-llt.solve(r)); };
+  RestShapeResponse out;
   for (const Eigen::VectorXd& b : dGp_dp) {
     Eigen::VectorXd y;
     const GmresResult g = gmres(apply_A, apply_Minv, Eigen::VectorXd(-Hp.gather(b)), 1e-6, 60, y);
-    out.iterations += g.iterations;
-    out.worst_residual = std::max(out.worst_residual, g.relative_residual);
-    out.converged = out.converged && g.converged;
-    out.dX.push_back(scatter(y));
+    out.add(g, scatter(y));
   }
   return out;
 }
@@ -162,16 +144,11 @@ RestResponse rest_shape_response(const RegistrationModel& m, const TotalEnergy& 
 /// at the imaged shape (dG_p/d ln E = G_elastic there), the q column zero without q. Where the
 /// rest shape inverts the quadratic model (its quadratic pass converged), that equation's
 /// (quadratic_unload_equation.h); where that pass kept the linear shape, the linear one's.
-RestResponse rest_response_to_material(const RegistrationModel& m, const TotalEnergy& elastic, bool with_q) {
-  const Eigen::VectorXd none = Eigen::VectorXd::Zero(3 * m.rest.V.rows());
-  if (m.unload && m.unload->unload.elements == ElementOrder::Quadratic) {
-    const QuadraticUnloadEquation eq(m);
-    return rest_shape_response(m, elastic, {eq.d_log_youngs_modulus(), with_q ? eq.d_compliance() : none},
-                               [&](const Eigen::VectorXd& v) { return eq.d_rest(v); },
-                               [&](const Eigen::VectorXd& r) { return eq.precondition(r); });
-  }
-  return rest_shape_response(m, elastic, {elastic.gradient(m.prone), with_q ? elastic_gradient_d_compliance(m, m.prone) : none},
-                             [&](const Eigen::VectorXd& v) { return gradient_d_rest(m, m.prone, v, m.unloaded_under); });
+RestShapeResponse rest_response_to_material(const RegistrationModel& m, const TotalEnergy& elastic, bool with_q) {
+  if (m.unload && m.unload->unload.elements == ElementOrder::Quadratic) return QuadraticUnloadEquation(m).rest_response(with_q);
+  return rest_shape_response(m, elastic,
+                             {elastic.gradient(m.prone),
+                              with_q ? elastic_gradient_d_compliance(m, m.prone) : Eigen::VectorXd::Zero(3 * m.rest.V.rows())});
 }
 
 bool fit_usable(const LandmarkStiffnessFit& fit, int nv) {
@@ -425,7 +402,7 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   std::vector<Eigen::VectorXd> dX_rest;  // per input (ln E, q); empty: the rest shape is the prone one
   if (model.unloaded_under.norm() > 0 && (sd_log_e > 0 || sd_q > 0)) {
     const auto t_rest = std::chrono::steady_clock::now();
-    const RestResponse rr = rest_response_to_material(model, elastic, sd_q > 0);
+    const RestShapeResponse rr = rest_response_to_material(model, elastic, sd_q > 0);
     dX_rest = rr.dX;
     const Vec3 g_s = gravity ? model.gravity : Vec3::Zero();
     full_E += gradient_d_rest(model, x, rr.dX[0], g_s);

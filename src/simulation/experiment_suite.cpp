@@ -287,7 +287,12 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           format_value(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()) + " s" +
           (generation_failure.empty() ? "" : " (" + generation_failure + ")"));
     }
-    std::map<double, std::pair<Points, StepReport>> unloaded;  // per method Young's modulus, this configuration
+    struct Unloaded {
+      Points rest;  // RegistrationModel::rest.V
+      StepReport report;
+      QuadraticEquilibrium equilibrium;
+    };
+    std::map<double, Unloaded> unloaded;  // per method Young's modulus, this configuration
     for (size_t ri = 0; ri < todo.size(); ++ri) {
       if (first_item + ri < share.first || first_item + ri >= share.last) continue;
       const ExperimentRun* run = todo[ri];
@@ -315,16 +320,16 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
             auto it = unloaded.find(run->method_youngs_modulus);
             if (it == unloaded.end()) {
               const StepReport u = unload_model(rm, *scene.prone_gravity);
-              it = unloaded.emplace(run->method_youngs_modulus, std::make_pair(rm.rest.V, u)).first;
+              it = unloaded.emplace(run->method_youngs_modulus, Unloaded{rm.rest.V, u, rm.unloaded_equilibrium}).first;
               say("unloaded shape for method E = " + format_value(run->method_youngs_modulus) + " Pa: " +
                   (u.converged ? "converged" : "not converged") + " (" + u.stop_reason + "), rest shape moved up to " +
                   format_value(u.unload.rest_change * 1e3) + " mm, re-simulated prone within " +
                   format_value(u.unload.mismatch * 1e3) + " mm, " + format_value(u.seconds) + " s" +
                   (u.note.empty() ? "" : "; " + u.note));
             } else {
-              set_rest_shape(rm, it->second.first, it->second.second, *scene.prone_gravity);
+              set_rest_shape(rm, it->second.rest, it->second.report, *scene.prone_gravity, it->second.equilibrium);
             }
-            unload_seconds = it->second.second.seconds;
+            unload_seconds = it->second.report.seconds;
           }
           RegistrationOptions ro = preset;
           ro.landmark.weight = run->landmark_weight;

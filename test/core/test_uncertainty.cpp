@@ -16,6 +16,7 @@
 #include "breast_tumour_registration/geometry/embedding.h"
 #include "breast_tumour_registration/geometry/margin_shell.h"
 #include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/registration/quadratic_unload_equation.h"
 #include "breast_tumour_registration/registration/stiffness_step.h"
 #include "breast_tumour_registration/registration/unload_step.h"
 #include "breast_tumour_registration/geometry/shapes.h"
@@ -536,6 +537,31 @@ TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFoll
 // the re-solves here.
 TEST(Uncertainty, AQuadraticallyUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFollowsIt) {
   expect_the_linearisation_follows_the_unloaded_rest_shape(ElementOrder::Quadratic);
+}
+
+// The quadratic unload's equation is linearised at the equilibrium its last forward solve found,
+// preconditioned by that solver's kept factor; where a model does not keep them (e.g. copied
+// from a cache that dropped them) one forward solve finds the equilibrium again. Both give the
+// same response (their factors differ: only the GMRES residual may).
+TEST(Uncertainty, TheQuadraticUnloadsEquationIsTheSameFromAKeptOrARefoundEquilibrium) {
+  Scene s = btr::test::coarse_phantom_scene();
+  s.prone_gravity = Vec3(0, 0, 9.81);
+  s.material.unload_element_order = ElementOrder::Quadratic;
+  std::vector<std::string> w;
+  const RegistrationModel kept = prepare_model(s, w);
+  ASSERT_TRUE(kept.unload && kept.unload->unload.elements == ElementOrder::Quadratic) << "not unloaded quadratically";
+  ASSERT_TRUE(kept.unloaded_equilibrium.solver && kept.unloaded_equilibrium.solver->has_factor());
+  RegistrationModel refound = kept;
+  refound.unloaded_equilibrium = {};
+  const RestShapeResponse a = QuadraticUnloadEquation(kept).rest_response(true);
+  const RestShapeResponse b = QuadraticUnloadEquation(refound).rest_response(true);
+  ASSERT_TRUE(a.converged && b.converged);
+  std::printf("GMRES products: %d from the kept factor, %d from a fresh one\n", a.iterations, b.iterations);
+  for (int input = 0; input < 2; ++input) {
+    const double size = a.dX[input].cwiseAbs().maxCoeff();
+    EXPECT_GT(size, 0.0);
+    EXPECT_LT((a.dX[input] - b.dX[input]).cwiseAbs().maxCoeff(), 1e-3 * size) << "input " << input;
+  }
 }
 
 // Where E is estimated from the landmarks, a true Poisson's ratio other than the method's moves
