@@ -312,6 +312,7 @@ Scene load_scene_fields(const std::string& path) {
     if (m["unload_element_order"])
       c.load("material.unload_element_order", [&] {
         s.material.unload_element_order = parse_element_order(c.text(m["unload_element_order"], "material.unload_element_order"));
+        s.unload_element_order_stated = true;
         return 0;
       });
     if (m["nodal_fallback"]) s.nodal_fallback = c.boolean(m["nodal_fallback"], "material.nodal_fallback");

@@ -89,7 +89,7 @@ RegistrationEngine::RegistrationEngine(Scene simulated, RegistrationModel model,
   e->prepared.scene = std::move(simulated);
   e->prepared.model = std::move(model);
   e->prepared.warnings = std::move(warnings);
-  entries_.emplace(0.0, std::move(e));
+  entries_.emplace(std::make_pair(0.0, scene_.material.unload_element_order), std::move(e));
 }
 
 RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& opt) {
@@ -102,9 +102,11 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
       preset_form ? VolumeForm::Nodal : resolve_volume_form(scene_.material.volume_form, scene_.material.poisson_ratio);
   RegistrationOptions mesh_opt = opt;  // with the mesh the preset simulates its nodal form on
   if (preset_form && opt.nodal_simulation_cell_size > 0) mesh_opt.simulation_cell_size = opt.nodal_simulation_cell_size;
-  // The key is the mesh the call simulates: the size a prone surface is meshed at, the preset's
-  // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given. The
-  // first call on a mesh prepares it with its form; the other form is the entry's twin.
+  // The key is the mesh the call simulates (the size a prone surface is meshed at, the preset's
+  // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given) and the
+  // elements it is unloaded with. The first call on a mesh prepares it with its form; the other
+  // form is the entry's twin.
+  const ElementOrder unload_elements = preset_unload_elements(scene_, opt);
   const bool unmeshed = scene_.prone.T.rows() == 0 && scene_.prone_source;
   double key = 0;
   if (unmeshed)
@@ -112,7 +114,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
                                                                                    : kDefaultCellSize);
   else if (needs_simulation_mesh(scene_, mesh_opt))
     key = mesh_opt.simulation_cell_size;
-  auto it = entries_.find(key);
+  auto it = entries_.find({key, unload_elements});
   if (it != entries_.end()) return twin_entry(*it->second, form);
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -129,10 +131,11 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
     p.scene = scene_;
   }
   if (preset_form) p.scene.material.volume_form = form;
+  p.scene.material.unload_element_order = unload_elements;
   p.mesh_seconds = key > 0 ? p.scene.tetrahedralize_seconds : 0;
   p.model = prepare_model(p.scene, p.warnings, unload_, &e->solvers);
   p.prepare_seconds = since(t0);
-  return *entries_.emplace(key, std::move(e)).first->second;
+  return *entries_.emplace(std::make_pair(key, unload_elements), std::move(e)).first->second;
 }
 
 const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt) { return entry(opt).prepared; }

@@ -62,7 +62,10 @@ namespace {
 // seventh session: nearer on six of seven bodies at a median 1.03 times the time) and accurate
 // the nodal form at 5 mm (eighth session, over three meshes per point on SfePy's five settings:
 // nearer than the default balanced on four, the element form at 4 mm on two; BENCHMARKS.md,
-// "The balanced preset's fallback, and one mesh is one draw").
+// "The balanced preset's fallback, and one mesh is one draw"). With that nodal form balanced
+// unloads with quadratic elements (2026-12-07: nearer on 11 of 15 scenes, 7 chosen on and 8 made
+// after, within 0.003 mm on the rest, at a median 2.2 times the call; at accurate's 5 mm it
+// gained nothing consistent; BENCHMARKS.md, "The quadratic unload in the balanced preset").
 struct Preset {
   const char* name;
   double simulation_cell_size;    ///< [m]; 0: the scene's own mesh
@@ -71,11 +74,12 @@ struct Preset {
   double projection_tolerance;    ///< [m] surface step, on the distance to the fixed point
   VolumeForm volume_form;         ///< where the scene says auto and unloads (RegistrationOptions::volume_form)
   double nodal_simulation_cell_size;  ///< [m] the mesh of that nodal form
+  ElementOrder unload_elements;   ///< with that nodal form (RegistrationOptions::unload_element_order)
 };
 constexpr Preset kPresets[] = {
-    {"fast", 0.009, 30, 1e-3, 2e-4, VolumeForm::Auto, 0},
-    {"balanced", 0.007, 60, 1e-4, 1e-4, VolumeForm::Nodal, 0.009},
-    {"accurate", 0.004, 60, 1e-6, 1e-5, VolumeForm::Nodal, 0.005},
+    {"fast", 0.009, 30, 1e-3, 2e-4, VolumeForm::Auto, 0, ElementOrder::Linear},
+    {"balanced", 0.007, 60, 1e-4, 1e-4, VolumeForm::Nodal, 0.009, ElementOrder::Quadratic},
+    {"accurate", 0.004, 60, 1e-6, 1e-5, VolumeForm::Nodal, 0.005, ElementOrder::Linear},
 };
 
 }  // namespace
@@ -101,12 +105,18 @@ RegistrationOptions preset_options(const std::string& name) {
   o.surface.projection_tolerance = p->projection_tolerance;
   o.volume_form = p->volume_form;
   o.nodal_simulation_cell_size = p->nodal_simulation_cell_size;
+  o.unload_element_order = p->unload_elements;
   return o;
 }
 
 bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt) {
   return scene.material.volume_form == VolumeForm::Auto && opt.volume_form == VolumeForm::Nodal &&
          scene.prone_gravity.has_value();
+}
+
+ElementOrder preset_unload_elements(const Scene& scene, const RegistrationOptions& opt) {
+  return takes_preset_volume_form(scene, opt) && !scene.unload_element_order_stated ? opt.unload_element_order
+                                                                                    : scene.material.unload_element_order;
 }
 
 std::string PlannedSteps::describe() const {

@@ -99,6 +99,10 @@ int main(int argc, char** argv) {
                 takes_preset_volume_form(engine.scene(), opt)
                     ? " (the preset's for a scene that unloads; material.volume_form: element keeps the element form)"
                     : "");
+    if (model.material.unload_element_order != ElementOrder::Linear && !engine.scene().unload_element_order_stated)
+      std::printf("[register] unloaded with %s elements (the preset's with its nodal form; material.unload_element_order: "
+                  "linear keeps linear ones)\n",
+                  to_string(model.material.unload_element_order));
     if (model.materials.size() > 1) {
       std::string mats;
       for (size_t i = 0; i < model.materials.size(); ++i)

@@ -145,6 +145,7 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   EXPECT_NE(pn.mesh_note.find("re-tetrahedralized"), std::string::npos) << pn.mesh_note;
   Scene stated = with_simulation_mesh(s, 0.025);
   stated.material.volume_form = VolumeForm::Nodal;
+  stated.material.unload_element_order = nodal.unload_element_order;  // the preset's with its nodal form
   EXPECT_EQ(largest_difference(r.x, fresh(stated, nodal).x), 0.0);  // as if the scene had said nodal, on that mesh
 
   const PreparedScene& pe = engine.prepare(by_poisson);
@@ -171,6 +172,44 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   prone_rest.prone_gravity.reset();
   EXPECT_FALSE(takes_preset_volume_form(prone_rest, balanced));
   EXPECT_EQ(RegistrationEngine(prone_rest).prepare(balanced).model.volume_form, VolumeForm::Element);
+}
+
+// With its nodal form the balanced preset unloads with quadratic elements, where the scene does
+// not state the unload's elements; a stated order wins, and a preset without the nodal form (or
+// a scene that keeps the prone shape) unloads as the scene says. The engine keeps one entry per
+// mesh and unload order, so a call's model does not depend on which preset asked first.
+TEST(Engine, TheBalancedPresetUnloadsWithQuadraticElementsWhereTheSceneLeavesItOpen) {
+  Scene s = btr::test::coarse_phantom_scene();
+  s.prone_gravity = Vec3(0, 0, 9.81);
+  ASSERT_FALSE(s.unload_element_order_stated);
+  const RegistrationOptions balanced = preset_options("balanced"), fast = preset_options("fast");
+  EXPECT_EQ(preset_unload_elements(s, balanced), ElementOrder::Quadratic);
+  EXPECT_EQ(preset_unload_elements(s, fast), ElementOrder::Linear);
+  EXPECT_EQ(preset_unload_elements(s, preset_options("accurate")), ElementOrder::Linear);
+  Scene stated = s;
+  stated.unload_element_order_stated = true;  // material.unload_element_order: linear
+  EXPECT_EQ(preset_unload_elements(stated, balanced), ElementOrder::Linear);
+  Scene element = s;
+  element.material.volume_form = VolumeForm::Element;  // the scene's own form: not the preset's choice
+  EXPECT_EQ(preset_unload_elements(element, balanced), ElementOrder::Linear);
+
+  auto unloaded_with = [](const PreparedScene& p) {
+    EXPECT_TRUE(p.model.unload.has_value());
+    return p.model.unload ? p.model.unload->unload.elements : ElementOrder::Linear;
+  };
+  RegistrationEngine fast_first(s), balanced_first(s);
+  const PreparedScene& f1 = fast_first.prepare(fast);
+  const PreparedScene& b1 = fast_first.prepare(balanced);
+  const PreparedScene& b2 = balanced_first.prepare(balanced);
+  const PreparedScene& f2 = balanced_first.prepare(fast);
+  EXPECT_EQ(unloaded_with(f1), ElementOrder::Linear);
+  EXPECT_EQ(unloaded_with(f2), ElementOrder::Linear);
+  EXPECT_EQ(unloaded_with(b1), ElementOrder::Quadratic);
+  EXPECT_EQ(unloaded_with(b2), ElementOrder::Quadratic);
+  EXPECT_EQ(largest_difference(f1.model.rest.V, f2.model.rest.V), 0.0);  // whichever preset came first
+  EXPECT_EQ(largest_difference(b1.model.rest.V, b2.model.rest.V), 0.0);
+  EXPECT_GT(largest_difference(b1.model.rest.V, f1.model.rest.V), 1e-4);  // the two unloads differ here
+  EXPECT_EQ(unloaded_with(RegistrationEngine(stated).prepare(balanced)), ElementOrder::Linear);
 }
 
 // Where the nodal form was the preset's choice (balanced: nodal on a 9 mm mesh where a scene

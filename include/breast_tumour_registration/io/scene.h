@@ -90,6 +90,9 @@ struct Scene {
   std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
   std::vector<SceneTumour> tumours;
   MaterialParameters material;
+  /// Whether the scene states `material.unload_element_order`; where it does not, a preset may
+  /// choose the unload's elements (RegistrationOptions::unload_element_order)
+  bool unload_element_order_stated = false;
   /// `material.nodal_fallback` (default true): a registration with the nodal volume form that
   /// ends not converged is run again with the element form, and that result is returned
   /// (RegistrationEngine; RegistrationResult::volume_form_fallback says why)

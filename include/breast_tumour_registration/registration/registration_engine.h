@@ -148,7 +148,8 @@ class RegistrationEngine {
   Scene scene_;
   UnloadOptions unload_;
   bool adopted_ = false;                           ///< one entry for every call
-  std::map<double, std::unique_ptr<Entry>> entries_;  ///< by simulation cell size [m]
+  /// By simulation cell size [m] and the unload's elements (preset_unload_elements)
+  std::map<std::pair<double, ElementOrder>, std::unique_ptr<Entry>> entries_;
 };
 
 }  // namespace btr

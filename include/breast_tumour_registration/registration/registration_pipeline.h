@@ -37,6 +37,11 @@ struct RegistrationOptions {
   /// Only unloading scenes: with the prone shape as the rest shape on soft tissue the nodal form
   /// folds the mesh and ends farther off (BENCHMARKS.md, "The nodal volume term as the default").
   VolumeForm volume_form = VolumeForm::Auto;
+  /// The preset's elements for the unloaded shape, taken with its nodal form (where
+  /// takes_preset_volume_form) when the scene does not state material.unload_element_order
+  /// (preset_unload_elements). Balanced: quadratic (BENCHMARKS.md, "The quadratic unload as the
+  /// balanced preset's default").
+  ElementOrder unload_element_order = ElementOrder::Linear;
   /// > 0: the simulation cell size [m] where the preset's nodal form is taken (the nodal form is
   /// the costlier per tetrahedron and locks less, so its point on the front is a coarser mesh)
   double nodal_simulation_cell_size = 0;
@@ -70,6 +75,11 @@ struct RegistrationOptions {
 /// (RegistrationOptions::volume_form): the scene's form is auto, it plans the unloaded shape, and
 /// the preset asks for the nodal form.
 bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt);
+
+/// The elements `scene` is unloaded with in a registration with `opt`: the preset's
+/// (RegistrationOptions::unload_element_order) where it takes its nodal form and the scene does
+/// not state them, else the scene's material.unload_element_order.
+ElementOrder preset_unload_elements(const Scene& scene, const RegistrationOptions& opt);
 
 /// Options of a preset: "fast", "balanced" or "accurate" (see BENCHMARKS.md for the
 /// measured speed and accuracy of each). Throws InputError for another name.
