@@ -56,7 +56,7 @@ NewtonResult ForwardGravity::solve_once(const Points& X, const Vec3& gravity, Po
   auto g = std::make_shared<GravityEnergy>(rest_, density_, gravity);
   energy.add(g);
   if (!solver_) {  // the pattern does not depend on the rest positions
-    own_ = std::make_shared<NewtonSolver>(
+    own_ = std::make_unique<NewtonSolver>(
         std::make_shared<HessianAssembler>(static_cast<int>(X.rows()), rest_.T, fixed_, energy.hessian_cliques()), rest_.T);
     solver_ = own_.get();
   }
@@ -80,7 +80,7 @@ NewtonResult ForwardGravity::solve_once_quadratic(const Points& X, const Vec3& g
   energy.add(elastic);
   energy.add(g);
   if (!solver_) {  // the pattern couples each element's 10 nodes; inversions are its Jacobian's (inversion_check.h)
-    own_ = std::make_shared<NewtonSolver>(
+    own_ = std::make_unique<NewtonSolver>(
         std::make_shared<HessianAssembler>(static_cast<int>(quadratic_.nodes()), rest_.T, quadratic_fixed_,
                                            energy.hessian_cliques()),
         InversionCheck::quadratic(quadratic_, opt_.quadrature_degree));

@@ -357,8 +357,6 @@ class SparseCholeskySolve : public NewtonLinearSolve {
     return d;
   }
   void forget_factor() override { have_factor_ = false; }
-  /// The last factor alone (no low-rank part: low_ may be gone with its solve).
-  Eigen::VectorXd solve_with_factor(const Eigen::VectorXd& rhs) const { return llt_.solve(rhs); }
 
  private:
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt_;
@@ -380,16 +378,6 @@ NewtonSolver::NewtonSolver(std::shared_ptr<HessianAssembler> assembler, Inversio
 NewtonSolver::~NewtonSolver() = default;
 
 void NewtonSolver::forget_factor() { impl_->linear.forget_factor(); }
-
-bool NewtonSolver::has_factor() const { return impl_->linear.has_factor(); }
-
-Eigen::VectorXd NewtonSolver::solve_with_factor(const Eigen::VectorXd& free_rhs) const {
-  if (!has_factor()) throw SolverError("Newton solver: no factor to solve with (no Hessian factorized yet)");
-  if (free_rhs.size() != assembler_->num_free_dofs())
-    throw InputError("Newton solver: a right-hand side of " + std::to_string(free_rhs.size()) + " rows, " +
-                     std::to_string(assembler_->num_free_dofs()) + " free DOFs");
-  return impl_->linear.solve_with_factor(free_rhs);
-}
 
 NewtonResult NewtonSolver::solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt) {
   return newton_minimize(energy, *assembler_, inversions_, impl_->linear, x, opt);

@@ -241,7 +241,7 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
   } else {
     res.rest = result.X;
     res.resimulated = result.x;
-    res.quadratic = {result.nodes, phi.quadratic_solver()};
+    res.resimulated_nodes = result.nodes;
     res.max_mismatch = result.best;
   }
   res.forward_solve_equivalents = first > 0 ? static_cast<double>(res.newton_iterations) / first : 0.0;

@@ -5,6 +5,7 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
+#include "breast_tumour_registration/fem/hessian_factor.h"
 #include "breast_tumour_registration/fem/quadratic_elastic_energy.h"
 #include "breast_tumour_registration/fem/total_energy.h"
 #include "breast_tumour_registration/registration/tumour_uncertainty.h"
@@ -28,8 +29,8 @@ std::vector<StableNeoHookean> scaled(const std::vector<StableNeoHookean>& materi
   return out;
 }
 
-/// The quadratic model's equilibrium from the model's rest shape, solved.
-QuadraticEquilibrium solve_equilibrium(const RegistrationModel& model, int degree) {
+/// The quadratic model's equilibrium from the model's rest shape, solved: every node.
+Points solve_equilibrium(const RegistrationModel& model, int degree) {
   ForwardGravityOptions o;
   o.element_order = ElementOrder::Quadratic;
   o.quadrature_degree = degree;
@@ -37,10 +38,14 @@ QuadraticEquilibrium solve_equilibrium(const RegistrationModel& model, int degre
                      model.volume_form, model.material.nodal_element_share, model.material.density, o);
   Points x = model.prone;
   phi.solve(model.rest.V, model.unloaded_under, x);
-  return {phi.quadratic_nodes(), phi.quadratic_solver()};
+  return phi.quadratic_nodes();
 }
 
 }  // namespace
+
+struct QuadraticUnloadEquation::Factor {
+  HessianLlt llt;
+};
 
 void RestShapeResponse::add(const GmresResult& g, Eigen::VectorXd dX_input) {
   iterations += g.iterations;
@@ -53,11 +58,15 @@ QuadraticUnloadEquation::QuadraticUnloadEquation(const RegistrationModel& model,
     : model_(model), degree_(quadrature_degree) {
   if (!(model.unloaded_under.norm() > 0)) throw InputError("quadratic unload equation: the model was not unloaded");
   mesh_ = make_quadratic_tets(model.rest.T, model.rest.V.rows());
-  const QuadraticEquilibrium& kept = model.unloaded_equilibrium;
-  const bool usable = kept.nodes.rows() == mesh_.nodes() && kept.solver && kept.solver->has_factor();
-  equilibrium_ = usable ? kept : solve_equilibrium(model, degree_);
-  if (!equilibrium_.solver || !equilibrium_.solver->has_factor())
-    throw SolverError("quadratic unload equation: the equilibrium's solve kept no factor");
+  x_ = model.unloaded_nodes.rows() == mesh_.nodes() ? model.unloaded_nodes : solve_equilibrium(model, degree_);
+  std::vector<bool> wall(static_cast<size_t>(mesh_.nodes()));  // the forward model's fixed nodes
+  for (Eigen::Index v = 0; v < mesh_.corners; ++v) wall[static_cast<size_t>(v)] = model.fixed[static_cast<size_t>(v)];
+  for (size_t e = 0; e < mesh_.edges.size(); ++e)
+    wall[static_cast<size_t>(mesh_.corners) + e] = model.fixed[mesh_.edges[e][0]] && model.fixed[mesh_.edges[e][1]];
+  const TotalEnergy energy = quadratic_energy(model, mesh_, model.rest.V, model.materials, degree_);
+  free_ = std::make_unique<HessianAssembler>(static_cast<int>(mesh_.nodes()), model.rest.T, wall, energy.hessian_cliques());
+  k_ = std::make_unique<Factor>();
+  factorize_exact_or_projected(energy, x_, *free_, k_->llt, "quadratic unload equation: the Hessian at its equilibrium");
 }
 
 QuadraticUnloadEquation::~QuadraticUnloadEquation() = default;
@@ -75,33 +84,30 @@ Eigen::VectorXd QuadraticUnloadEquation::apply(const Eigen::VectorXd& d) const {
   const Points dX = D.topRows(mesh_.corners);
   Points dm = D;
   dm.topRows(mesh_.corners).setZero();
-  return (residual(model_.rest.V + eps * dX, model_.materials, equilibrium_.nodes + eps * dm) -
-          residual(model_.rest.V - eps * dX, model_.materials, equilibrium_.nodes - eps * dm)) /
+  return (residual(model_.rest.V + eps * dX, model_.materials, x_ + eps * dm) -
+          residual(model_.rest.V - eps * dX, model_.materials, x_ - eps * dm)) /
          (2 * eps);
 }
 
 Eigen::VectorXd QuadraticUnloadEquation::d_log_youngs_modulus() const {
   const double h = 1e-3, nu = model_.material.poisson_ratio;
-  return (residual(model_.rest.V, scaled(model_.materials, std::exp(h), nu), equilibrium_.nodes) -
-          residual(model_.rest.V, scaled(model_.materials, std::exp(-h), nu), equilibrium_.nodes)) /
+  return (residual(model_.rest.V, scaled(model_.materials, std::exp(h), nu), x_) -
+          residual(model_.rest.V, scaled(model_.materials, std::exp(-h), nu), x_)) /
          (2 * h);
 }
 
 Eigen::VectorXd QuadraticUnloadEquation::d_compliance() const {
   const double q0 = volume_compliance(model_.material.poisson_ratio), h = 1e-3 * q0;
-  return (residual(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 + h)), equilibrium_.nodes) -
-          residual(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 - h)), equilibrium_.nodes)) /
+  return (residual(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 + h)), x_) -
+          residual(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 - h)), x_)) /
          (2 * h);
 }
 
 RestShapeResponse QuadraticUnloadEquation::rest_response(bool with_q) const {
-  // The kept factor is of a Hessian some forward solves back: on the 8 mm phantom at 1000 Pa,
-  // 1e-6 took 49 products (18 with a fresh factor at the equilibrium), 1e-4 32, radii the same
-  // to 0.01 mm.
+  // On the 8 mm phantom at 1000 Pa 1e-4 gave the radii of 1e-6 to 0.01 mm in fewer products.
   constexpr double kTolerance = 1e-4;
   const Eigen::Index nodes = mesh_.nodes(), nc = mesh_.corners;
-  const NewtonSolver& solver = *equilibrium_.solver;
-  const HessianAssembler& free = solver.assembler();
+  const HessianAssembler& free = *free_;
   auto scatter = [&](const Eigen::VectorXd& reduced) {
     Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nodes);
     free.scatter_add(reduced, 1.0, full);
@@ -109,7 +115,7 @@ RestShapeResponse QuadraticUnloadEquation::rest_response(bool with_q) const {
   };
   auto apply_A = [&](const Eigen::VectorXd& v) { return Eigen::VectorXd(free.gather(apply(scatter(v)))); };
   auto apply_Minv = [&](const Eigen::VectorXd& r) {  // L K^-1 r
-    const Eigen::VectorXd y = scatter(solver.solve_with_factor(r));
+    const Eigen::VectorXd y = scatter(k_->llt.solve(r));
     Eigen::VectorXd out = y;
     out.head(3 * nc) = -y.head(3 * nc);
     for (size_t e = 0; e < mesh_.edges.size(); ++e)

@@ -26,7 +26,7 @@ class StiffnessStep : public RegistrationStep {
     RegistrationModel m = c.prepared();
     scale_stiffness(m, est.scale);
     set_rest_shape(m, est.rest, unload_report(est.unload, c.prepared().prone), *c.scene.prone_gravity,
-                   est.unload.quadratic);
+                   est.unload.resimulated_nodes);
     c.use_estimated_model(std::move(m));
     StepReport rep;
     rep.name = name();

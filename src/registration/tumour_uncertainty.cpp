@@ -1,6 +1,5 @@
 #include "breast_tumour_registration/registration/tumour_uncertainty.h"
 
-#include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/QR>
@@ -14,6 +13,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/blas_threads.h"
 #include "breast_tumour_registration/fem/heap_retention.h"
+#include "breast_tumour_registration/fem/hessian_factor.h"
 #include "breast_tumour_registration/fem/gmres.h"
 #include "breast_tumour_registration/fem/gravity_energy.h"
 #include "breast_tumour_registration/fem/hessian_pattern.h"
@@ -51,23 +51,6 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
     p += 2.0 * h1 * normal(z1) * inner;
   }
   return p;
-}
-
-using Llt = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>;
-
-/// Factorizes the Hessian of `energy` at x into llt: the exact one, or, when it is not positive
-/// definite there, the projected one (returns true then). Throws SolverError naming `what` when
-/// neither factorizes.
-bool factorize_exact_or_projected(const TotalEnergy& energy, const Points& x, HessianAssembler& H, Llt& llt,
-                                  const std::string& what) {
-  llt.cholmod().print = 0;
-  energy.hessian(x, false, H);
-  llt.compute(H.matrix());
-  if (llt.info() == Eigen::Success) return false;
-  energy.hessian(x, true, H);
-  llt.compute(H.matrix());
-  if (llt.info() != Eigen::Success) throw SolverError("uncertainty: " + what + " cannot be factorized");
-  return true;
 }
 
 /// The model's materials with every tissue's Poisson's ratio set to `nu`, each keeping its
@@ -120,8 +103,8 @@ RestShapeResponse rest_shape_response(const RegistrationModel& m, const TotalEne
                                       const std::vector<Eigen::VectorXd>& dGp_dp) {
   const int nv = static_cast<int>(m.rest.V.rows());
   HessianAssembler Hp(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
-  Llt llt;  // only the preconditioner: the projected one serves too
-  factorize_exact_or_projected(elastic, m.prone, Hp, llt, "the prone Hessian");
+  HessianLlt llt;  // only the preconditioner: the projected one serves too
+  factorize_exact_or_projected(elastic, m.prone, Hp, llt, "uncertainty: the prone Hessian");
   auto scatter = [&](const Eigen::VectorXd& reduced) {
     Eigen::VectorXd full = Eigen::VectorXd::Zero(3 * nv);
     Hp.scatter_add(reduced, 1.0, full);
@@ -169,8 +152,8 @@ LandmarkFitMotion landmark_fit_motion(const RegistrationModel& m, const TotalEne
   const int nv = static_cast<int>(m.rest.V.rows());
   const Points& xg = fit.supine_prediction;
   HessianAssembler Hg(nv, m.rest.T, m.fixed, elastic.hessian_cliques());
-  Llt llt;
-  factorize_exact_or_projected(elastic, xg, Hg, llt, "the stiffness prediction's Hessian");
+  HessianLlt llt;
+  factorize_exact_or_projected(elastic, xg, Hg, llt, "uncertainty: the stiffness prediction's Hessian");
   const int n = static_cast<int>(fit.anchors.size());
   auto landmark_motion = [&](Eigen::VectorXd partial, int input) {
     if (!dX_rest.empty()) partial += gradient_d_rest(m, xg, dX_rest[input], m.gravity);
@@ -365,10 +348,10 @@ UncertaintyResult linearised_tumour_uncertainty(const RegistrationModel& model, 
   HessianAssembler H(nv, model.rest.T, model.fixed, jac.hessian_cliques());
   use_single_threaded_blas();
   keep_freed_heap_memory();
-  Llt llt;
+  HessianLlt llt;
   // An element compressed past its stable range makes the exact Hessian indefinite there; the
   // projected one is a bound on the stiffness, so the spread it gives is a lower bound.
-  if (factorize_exact_or_projected(jac, x, H, llt, "the fixed point's Jacobian"))
+  if (factorize_exact_or_projected(jac, x, H, llt, "uncertainty: the fixed point's Jacobian"))
     out.note = "the exact Hessian is not positive definite at the result; linearised on the projected one (a lower bound)";
   // The pose's rank-6 part (H - W M W^T, free DOFs), by the Woodbury identity as the Newton
   // solver applies it; empty with a held pose.

@@ -9,7 +9,7 @@
 namespace btr {
 
 void set_rest_shape(RegistrationModel& model, const Points& rest, const StepReport& report, const Vec3& unloaded_under,
-                    const QuadraticEquilibrium& equilibrium) {
+                    const Points& nodes) {
   if (rest.rows() != model.prone.rows() || rest.cols() != 3 || !rest.allFinite())
     throw InputError("unload: the rest shape has " + std::to_string(rest.rows()) + " finite vertices, the model " +
                      std::to_string(model.prone.rows()));
@@ -19,7 +19,7 @@ void set_rest_shape(RegistrationModel& model, const Points& rest, const StepRepo
   for (Eigen::Index t = 0; t < model.rest.T.rows(); ++t) model.volume += tet_signed_volume(model.rest.V, model.rest.T, t);
   model.unload = report;
   model.unloaded_under = unloaded_under;
-  model.unloaded_equilibrium = equilibrium;
+  model.unloaded_nodes = nodes;
 }
 
 UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity) {
@@ -97,14 +97,14 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
     rep.unload.rest_change = 0;
     model.unload = rep;
     model.unloaded_under = Vec3::Zero();  // the rest shape is the prone shape
-    model.unloaded_equilibrium = {};
+    model.unloaded_nodes = Points();
     return rep;
   }
   if (!u.converged)
     rep.note = "stopped before converging (" + u.stop_reason + "); its best estimate reproduces the prone shape within " +
                format_mm(u.max_mismatch, 2) + " (the prone shape as rest: about " + format_mm(prone_as_rest_mismatch, 1) +
                ") and is used";
-  set_rest_shape(model, u.rest, rep, prone_gravity, u.quadratic);
+  set_rest_shape(model, u.rest, rep, prone_gravity, u.resimulated_nodes);
   return rep;
 }
 

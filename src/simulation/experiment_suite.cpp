@@ -288,9 +288,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           (generation_failure.empty() ? "" : " (" + generation_failure + ")"));
     }
     struct Unloaded {
-      Points rest;  // RegistrationModel::rest.V
+      Points rest, nodes;  // RegistrationModel::rest.V and unloaded_nodes
       StepReport report;
-      QuadraticEquilibrium equilibrium;
     };
     std::map<double, Unloaded> unloaded;  // per method Young's modulus, this configuration
     for (size_t ri = 0; ri < todo.size(); ++ri) {
@@ -320,14 +319,14 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
             auto it = unloaded.find(run->method_youngs_modulus);
             if (it == unloaded.end()) {
               const StepReport u = unload_model(rm, *scene.prone_gravity);
-              it = unloaded.emplace(run->method_youngs_modulus, Unloaded{rm.rest.V, u, rm.unloaded_equilibrium}).first;
+              it = unloaded.emplace(run->method_youngs_modulus, Unloaded{rm.rest.V, rm.unloaded_nodes, u}).first;
               say("unloaded shape for method E = " + format_value(run->method_youngs_modulus) + " Pa: " +
                   (u.converged ? "converged" : "not converged") + " (" + u.stop_reason + "), rest shape moved up to " +
                   format_value(u.unload.rest_change * 1e3) + " mm, re-simulated prone within " +
                   format_value(u.unload.mismatch * 1e3) + " mm, " + format_value(u.seconds) + " s" +
                   (u.note.empty() ? "" : "; " + u.note));
             } else {
-              set_rest_shape(rm, it->second.rest, it->second.report, *scene.prone_gravity, it->second.equilibrium);
+              set_rest_shape(rm, it->second.rest, it->second.report, *scene.prone_gravity, it->second.nodes);
             }
             unload_seconds = it->second.report.seconds;
           }

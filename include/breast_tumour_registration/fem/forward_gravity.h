@@ -76,11 +76,6 @@ class ForwardGravity {
   /// first, then edge nodes), for evaluating the quadratic field (quadratic_interpolate).
   const QuadraticTetMesh& quadratic_mesh() const { return quadratic_; }
   const Points& quadratic_nodes() const { return quadratic_x_; }
-  /// Quadratic elements: the solver, with the factor of its last Hessian (quadratic_nodes()'s or
-  /// nearby; NewtonSolver::solve_with_factor), kept alive by the caller if wanted. Else null.
-  std::shared_ptr<const NewtonSolver> quadratic_solver() const {
-    return opt_.element_order == ElementOrder::Quadratic ? own_ : nullptr;
-  }
 
  private:
   NewtonResult solve_once(const Points& X, const Vec3& gravity, Points& x);
@@ -94,7 +89,7 @@ class ForwardGravity {
   double nodal_element_share_;
   double density_;
   ForwardGravityOptions opt_;
-  std::shared_ptr<NewtonSolver> own_;
+  std::unique_ptr<NewtonSolver> own_;
   NewtonSolver* solver_ = nullptr;  ///< own_, or the shared one
   int newton_iterations_ = 0, load_steps_ = 0;
   NewtonResult last_;

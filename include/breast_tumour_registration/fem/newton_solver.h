@@ -177,16 +177,6 @@ class NewtonSolver {
   NewtonResult solve(const TotalEnergy& energy, Points& x, const NewtonOptions& opt);
 
   HessianAssembler& assembler() { return *assembler_; }
-  const HessianAssembler& assembler() const { return *assembler_; }
-
-  /// Whether a numeric factor is kept (a solve factorized a Hessian, and it was not forgotten).
-  bool has_factor() const;
-  /// Solves with the kept factor alone (free DOFs, the assembler's order): that of the last
-  /// Hessian factorized (exact, projected or shifted; with lagged-factor steps, perhaps some
-  /// iterations before the last), so an approximate inverse of the Hessian at or near the last
-  /// solve's end, e.g. a preconditioner for linearising there. Throws SolverError without one,
-  /// InputError on a wrong size.
-  Eigen::VectorXd solve_with_factor(const Eigen::VectorXd& free_rhs) const;
 
   /// Drops the numeric factor (the symbolic analysis stays): the next solve starts as a new
   /// solver would, without a lagged factor of an earlier problem as its preconditioner.

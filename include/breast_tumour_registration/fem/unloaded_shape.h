@@ -41,20 +41,13 @@ struct UnloadOptions {
   ForwardGravityOptions forward;
 };
 
-/// A quadratic model's gravity equilibrium, kept to linearise there (the quadratic unload's
-/// equation, quadratic_unload_equation.h): every node (corners, then edge nodes) and the forward
-/// solver whose kept factor, of a Hessian at or near it, preconditions that linearisation.
-struct QuadraticEquilibrium {
-  Points nodes;
-  std::shared_ptr<const NewtonSolver> solver;
-};
-
 struct UnloadResult {
   Points rest;          ///< the estimated stress-free positions (the fixed vertices keep x_p's)
   ElementOrder elements = ElementOrder::Linear;  ///< of the forward model it inverts (options.forward.element_order)
   Points resimulated;   ///< phi(rest): the forward equilibrium from it
-  /// Quadratic elements: that equilibrium with every node, and its solver; else empty.
-  QuadraticEquilibrium quadratic;
+  /// Quadratic elements: every node of that equilibrium (corners, then edge nodes), where the
+  /// quadratic unload's equation is linearised (quadratic_unload_equation.h); else empty.
+  Points resimulated_nodes;
   bool converged = false;
   std::string stop_reason;
   int iterations = 0;          ///< forward gravity solves attempted, over all stages (inverse-gravity ones included)

@@ -9,11 +9,12 @@
 //
 // Solved jointly for (dX, dm): J [dX; dm] = -dR/dp, J = [dR/dX, dR/dm], by GMRES on products
 // from central differences of R, at the equilibrium the unload's last forward solve found
-// (RegistrationModel::unloaded_equilibrium; its corners within the unload's tolerance of x_p).
+// (RegistrationModel::unloaded_nodes; its corners within the unload's tolerance of x_p).
 // Preconditioner: for small strains moving the rest shape is moving the deformed one backwards,
 // dR/dX ~ -K [I; P] (K the Hessian in the deformed nodes, P the edge midpoints' interpolation),
-// so J ~ K L with L [a; b] = [-a; b - P a], its own inverse: M^-1 = L K^-1, K^-1 from the
-// factor that forward solve kept (no factorization here).
+// so J ~ K L with L [a; b] = [-a; b - P a], its own inverse: M^-1 = L K^-1, one factorization
+// of K at that equilibrium. (Keeping the forward solver's own factor instead saved it but held
+// 172 MB per prepared 7.3k-tet model for an optional output, and its age doubled the products.)
 #pragma once
 
 #include <memory>
@@ -21,6 +22,7 @@
 
 #include "breast_tumour_registration/fem/forward_gravity.h"
 #include "breast_tumour_registration/fem/gmres.h"
+#include "breast_tumour_registration/fem/hessian_pattern.h"
 #include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
 #include "breast_tumour_registration/registration/registration_model.h"
@@ -40,8 +42,9 @@ struct RestShapeResponse {
 class QuadraticUnloadEquation {
  public:
   /// At the model's rest shape under model.unloaded_under: the quadratic model's equilibrium
-  /// from it (model.unloaded_equilibrium; where it was not kept, one forward solve from the
-  /// prone shape). Throws SolverError where that solve fails, InputError on a model not unloaded.
+  /// from it (model.unloaded_nodes; where they were not kept, one forward solve from the prone
+  /// shape) and one factorization of its Hessian there. Throws SolverError where that solve or
+  /// factorization fails, InputError on a model not unloaded.
   /// quadrature_degree: the unload's forward model's (ForwardGravityOptions).
   explicit QuadraticUnloadEquation(const RegistrationModel& model,
                                    int quadrature_degree = ForwardGravityOptions{}.quadrature_degree);
@@ -51,10 +54,9 @@ class QuadraticUnloadEquation {
   /// (q = (1 - 2 nu) / (2 nu) of every material), by GMRES to a relative residual of 1e-4.
   RestShapeResponse rest_response(bool with_q) const;
 
+ private:
   /// J [d], d every node's (corners: dX, edge nodes: dm; 3 rows each), every node's rows.
   Eigen::VectorXd apply(const Eigen::VectorXd& d) const;
-
- private:
   /// R at every node, the body's rest corners X with `materials`, its nodes at `x`.
   Eigen::VectorXd residual(const Points& X, const std::vector<StableNeoHookean>& materials, const Points& x) const;
   /// dR/dp by a central difference of the materials, scaled (ln E) or given a Poisson's ratio (q).
@@ -64,7 +66,10 @@ class QuadraticUnloadEquation {
   const RegistrationModel& model_;
   int degree_;
   QuadraticTetMesh mesh_;
-  QuadraticEquilibrium equilibrium_;  ///< its solver's assembler: every node free but the chest wall's
+  Points x_;  ///< every node at the equilibrium
+  std::unique_ptr<HessianAssembler> free_;  ///< every node free but the chest wall's
+  struct Factor;  ///< K's Cholesky factor (hessian_factor.h)
+  std::unique_ptr<Factor> k_;
 };
 
 }  // namespace btr

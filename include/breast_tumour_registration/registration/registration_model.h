@@ -14,7 +14,6 @@
 #include "breast_tumour_registration/fem/material_parameters.h"
 #include "breast_tumour_registration/fem/newton_solver.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
-#include "breast_tumour_registration/fem/unloaded_shape.h"
 #include "breast_tumour_registration/geometry/embedding.h"
 
 namespace btr {
@@ -107,9 +106,10 @@ struct RegistrationModel {
   /// region follows it: tumour_uncertainty.h).
   Vec3 unloaded_under = Vec3::Zero();
   /// Where the rest shape inverts the quadratic model (unload->unload.elements quadratic): that
-  /// model's equilibrium from it (UnloadResult::quadratic), where the linear region linearises
-  /// the unload's equation. Empty otherwise, or when not kept (then solved again there).
-  QuadraticEquilibrium unloaded_equilibrium;
+  /// model's equilibrium from it, every node (UnloadResult::resimulated_nodes), where the linear
+  /// region linearises the unload's equation. Empty otherwise, or when not kept (then solved
+  /// again there).
+  Points unloaded_nodes;
   std::vector<int> chest_wall;     ///< fixed vertices
   std::vector<bool> fixed;         ///< #V flags
   std::vector<int> skin;           ///< boundary vertices that are not fixed

@@ -53,10 +53,10 @@ StepReport unload_report(const UnloadResult& unload, const Points& prone);
 
 /// Makes `rest` (an unloaded shape found before, e.g. cached) the rest shape of `model`,
 /// recording `report` as its unload step and `unloaded_under` as the gravity it was unloaded
-/// under (zero: `rest` is not an unloaded shape, e.g. the prone shape itself), and `equilibrium`
-/// as its quadratic model's (RegistrationModel::unloaded_equilibrium; empty: none kept). Throws
+/// under (zero: `rest` is not an unloaded shape, e.g. the prone shape itself), and `nodes` as its
+/// quadratic model's equilibrium (RegistrationModel::unloaded_nodes; empty: none kept). Throws
 /// InputError when the size does not match or an element of it is inverted.
 void set_rest_shape(RegistrationModel& model, const Points& rest, const StepReport& report, const Vec3& unloaded_under,
-                    const QuadraticEquilibrium& equilibrium = {});
+                    const Points& nodes = Points());
 
 }  // namespace btr
