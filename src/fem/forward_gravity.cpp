@@ -32,8 +32,7 @@ ForwardGravity::ForwardGravity(const Tetrahedra& T, Eigen::Index vertices, const
   }
   if (opt_.element_order == ElementOrder::Quadratic) {
     quadratic_ = make_quadratic_tets(T, vertices);
-    quadratic_fixed_ = fixed_;
-    for (const auto& e : quadratic_.edges) quadratic_fixed_.push_back(fixed_[e[0]] && fixed_[e[1]]);
+    quadratic_fixed_ = quadratic_fixed_nodes(quadratic_, fixed_);
     bulge_ = Points::Zero(static_cast<Eigen::Index>(quadratic_.edges.size()), 3);
     (void)tet_quadrature(opt_.quadrature_degree);  // throws for a degree without a rule
     return;

@@ -31,6 +31,15 @@ QuadraticTetMesh make_quadratic_tets(const Tetrahedra& T, Eigen::Index vertices)
   return q;
 }
 
+std::vector<bool> quadratic_fixed_nodes(const QuadraticTetMesh& q, const std::vector<bool>& corner_fixed) {
+  if (static_cast<Eigen::Index>(corner_fixed.size()) != q.corners)
+    throw InputError("quadratic tetrahedra: " + std::to_string(corner_fixed.size()) + " fixed flags for " +
+                     std::to_string(q.corners) + " vertices");
+  std::vector<bool> fixed = corner_fixed;
+  for (const auto& e : q.edges) fixed.push_back(corner_fixed[e[0]] && corner_fixed[e[1]]);
+  return fixed;
+}
+
 Points straight_sided_positions(const QuadraticTetMesh& q, const Points& corners) {
   if (corners.rows() != q.corners)
     throw InputError("quadratic tetrahedra: " + std::to_string(corners.rows()) + " corner positions for " +

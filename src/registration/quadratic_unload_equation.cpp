@@ -23,12 +23,6 @@ TotalEnergy quadratic_energy(const RegistrationModel& m, const QuadraticTetMesh&
   return e;
 }
 
-std::vector<StableNeoHookean> scaled(const std::vector<StableNeoHookean>& materials, double factor, double nu) {
-  std::vector<StableNeoHookean> out;
-  for (const auto& mat : materials) out.emplace_back(mat.youngs_modulus() * factor, nu);
-  return out;
-}
-
 /// The quadratic model's equilibrium from the model's rest shape, solved: every node.
 Points solve_equilibrium(const RegistrationModel& model, int degree) {
   ForwardGravityOptions o;
@@ -59,10 +53,7 @@ QuadraticUnloadEquation::QuadraticUnloadEquation(const RegistrationModel& model,
   if (!(model.unloaded_under.norm() > 0)) throw InputError("quadratic unload equation: the model was not unloaded");
   mesh_ = make_quadratic_tets(model.rest.T, model.rest.V.rows());
   x_ = model.unloaded_nodes.rows() == mesh_.nodes() ? model.unloaded_nodes : solve_equilibrium(model, degree_);
-  std::vector<bool> wall(static_cast<size_t>(mesh_.nodes()));  // the forward model's fixed nodes
-  for (Eigen::Index v = 0; v < mesh_.corners; ++v) wall[static_cast<size_t>(v)] = model.fixed[static_cast<size_t>(v)];
-  for (size_t e = 0; e < mesh_.edges.size(); ++e)
-    wall[static_cast<size_t>(mesh_.corners) + e] = model.fixed[mesh_.edges[e][0]] && model.fixed[mesh_.edges[e][1]];
+  const std::vector<bool> wall = quadratic_fixed_nodes(mesh_, model.fixed);  // the forward model's fixed nodes
   const TotalEnergy energy = quadratic_energy(model, mesh_, model.rest.V, model.materials, degree_);
   free_ = std::make_unique<HessianAssembler>(static_cast<int>(mesh_.nodes()), model.rest.T, wall, energy.hessian_cliques());
   k_ = std::make_unique<Factor>();
@@ -91,15 +82,15 @@ Eigen::VectorXd QuadraticUnloadEquation::apply(const Eigen::VectorXd& d) const {
 
 Eigen::VectorXd QuadraticUnloadEquation::d_log_youngs_modulus() const {
   const double h = 1e-3, nu = model_.material.poisson_ratio;
-  return (residual(model_.rest.V, scaled(model_.materials, std::exp(h), nu), x_) -
-          residual(model_.rest.V, scaled(model_.materials, std::exp(-h), nu), x_)) /
+  return (residual(model_.rest.V, materials_at(model_, nu, std::exp(h)), x_) -
+          residual(model_.rest.V, materials_at(model_, nu, std::exp(-h)), x_)) /
          (2 * h);
 }
 
 Eigen::VectorXd QuadraticUnloadEquation::d_compliance() const {
   const double q0 = volume_compliance(model_.material.poisson_ratio), h = 1e-3 * q0;
-  return (residual(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 + h)), x_) -
-          residual(model_.rest.V, scaled(model_.materials, 1.0, poisson_ratio_of_compliance(q0 - h)), x_)) /
+  return (residual(model_.rest.V, materials_at(model_, poisson_ratio_of_compliance(q0 + h)), x_) -
+          residual(model_.rest.V, materials_at(model_, poisson_ratio_of_compliance(q0 - h)), x_)) /
          (2 * h);
 }
 

@@ -53,14 +53,6 @@ double chi_square_mixture_cdf(const Vec3& l, double r) {
   return p;
 }
 
-/// The model's materials with every tissue's Poisson's ratio set to `nu`, each keeping its
-/// Young's modulus (as set_poisson_ratio does).
-std::vector<StableNeoHookean> materials_at(const RegistrationModel& m, double nu) {
-  std::vector<StableNeoHookean> out;
-  for (const auto& mat : m.materials) out.emplace_back(mat.youngs_modulus(), nu);
-  return out;
-}
-
 /// The body's gradient at x from rest positions `rest` with `materials` (elastic), plus that of
 /// `gravity` when it is non-zero (its masses come from the rest volumes) [N], every vertex.
 Eigen::VectorXd body_gradient(const RegistrationModel& m, const Points& rest, const std::vector<StableNeoHookean>& materials,
@@ -193,6 +185,12 @@ double per_compliance(const LandmarkFitMotion& f) {
 double volume_compliance(double nu) { return (1.0 - 2.0 * nu) / (2.0 * nu); }
 
 double poisson_ratio_of_compliance(double q) { return 1.0 / (2.0 * (1.0 + q)); }
+
+std::vector<StableNeoHookean> materials_at(const RegistrationModel& m, double nu, double youngs_factor) {
+  std::vector<StableNeoHookean> out;
+  for (const auto& mat : m.materials) out.emplace_back(mat.youngs_modulus() * youngs_factor, nu);
+  return out;
+}
 
 double volume_compliance_rms(const std::array<double, 2>& range, double nominal_nu) {
   if (!(range[1] > 0)) return 0;

@@ -533,9 +533,8 @@ TEST(Uncertainty, AnUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFoll
   expect_the_linearisation_follows_the_unloaded_rest_shape(ElementOrder::Linear);
 }
 
-// With quadratic elements the unload solves another equation (its edge nodes balanced at the
-// imaged corners: quadratic_unload_equation.h); the linear unload's response was 30 to 40 % off
-// the re-solves here.
+// With quadratic elements the unload solves another equation (rest corners and edge nodes:
+// quadratic_unload_equation.h); the linear unload's response was 30 to 40 % off the re-solves here.
 TEST(Uncertainty, AQuadraticallyUnloadedRestShapeMovesWithTheMaterialAndTheLinearisationFollowsIt) {
   expect_the_linearisation_follows_the_unloaded_rest_shape(ElementOrder::Quadratic);
 }

@@ -43,6 +43,10 @@ QuadraticTetMesh make_quadratic_tets(const Tetrahedra& T, Eigen::Index vertices)
 /// All node positions from the corner positions: each edge node at its edge's midpoint.
 Points straight_sided_positions(const QuadraticTetMesh& q, const Points& corners);
 
+/// Every node's fixed flag from the corners': an edge node is fixed where both its ends are.
+/// Throws InputError when corner_fixed does not have one flag per corner.
+std::vector<bool> quadratic_fixed_nodes(const QuadraticTetMesh& q, const std::vector<bool>& corner_fixed);
+
 
 /// The 10 shape functions at barycentric coordinates b (b sums to 1).
 Eigen::Matrix<double, 10, 1> quadratic_shape(const Vec4& b);

@@ -143,6 +143,10 @@ double volume_compliance(double nu);
 /// Its inverse: Poisson's ratio nu = 1 / (2 (1 + q)) of the volume compliance q.
 double poisson_ratio_of_compliance(double q);
 
+/// The model's materials with every tissue's Poisson's ratio set to `nu` and its Young's modulus
+/// scaled by `youngs_factor` (as set_poisson_ratio and scale_stiffness do to a whole model).
+std::vector<StableNeoHookean> materials_at(const RegistrationModel& m, double nu, double youngs_factor = 1.0);
+
 /// sqrt(E[(q(nu) - q(nominal_nu))^2]) for nu uniform over `range` (0 when the range is {0, 0}:
 /// held): the spread of the true compliance about the method's.
 double volume_compliance_rms(const std::array<double, 2>& range, double nominal_nu);
