@@ -50,6 +50,7 @@ StepReport unload_report(const UnloadResult& u, const Points& prone) {
 
 UnloadOptions with_model_elements(UnloadOptions options, const RegistrationModel& model) {
   options.forward.element_order = model.material.unload_element_order;
+  options.forward.quadrature_degree = kUnloadQuadratureDegree;  // read by quadratic elements only
   return options;
 }
 

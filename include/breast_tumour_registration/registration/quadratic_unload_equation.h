@@ -26,6 +26,7 @@
 #include "breast_tumour_registration/fem/quadratic_tetrahedra.h"
 #include "breast_tumour_registration/fem/stable_neo_hookean.h"
 #include "breast_tumour_registration/registration/registration_model.h"
+#include "breast_tumour_registration/registration/unload_step.h"
 
 namespace btr {
 
@@ -45,9 +46,8 @@ class QuadraticUnloadEquation {
   /// from it (model.unloaded_nodes; where they were not kept, one forward solve from the prone
   /// shape) and one factorization of its Hessian there. Throws SolverError where that solve or
   /// factorization fails, InputError on a model not unloaded.
-  /// quadrature_degree: the unload's forward model's (ForwardGravityOptions).
-  explicit QuadraticUnloadEquation(const RegistrationModel& model,
-                                   int quadrature_degree = ForwardGravityOptions{}.quadrature_degree);
+  /// quadrature_degree: the unload's forward model's (with_model_elements).
+  explicit QuadraticUnloadEquation(const RegistrationModel& model, int quadrature_degree = kUnloadQuadratureDegree);
   ~QuadraticUnloadEquation();
 
   /// dX/d ln E (every material's Young's modulus scaled alike) and, with_q, dX/dq
