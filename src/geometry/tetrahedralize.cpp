@@ -33,6 +33,9 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   if (!(opt.radius_edge_ratio >= 1.0))
     throw InputError("tetrahedralize: radius_edge_ratio must be >= 1 (2 guarantees termination)");
   if (!(opt.facet_distance_ratio > 0)) throw InputError("tetrahedralize: facet_distance_ratio must be positive");
+  if (surface.F.rows() < 4)  // CGAL's domain dereferences the faces' bounding tree: an empty one crashed it
+    throw InputError("tetrahedralize: the surface has " + std::to_string(surface.F.rows()) +
+                     " faces; a closed surface has at least 4");
   // Memory budget, checked before meshing (issue 11: --cell-size 0.5 grew without limit).
   // CGAL makes about 4.3 V / c^3 tetrahedra at cell size c (34.7k for the 0.84 L phantom at
   // 4.7 mm); each costs about 1 kB through meshing, assembly and factorization.

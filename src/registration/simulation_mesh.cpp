@@ -13,6 +13,12 @@ namespace btr {
 Scene with_simulation_mesh(const Scene& scene, double cell_size) {
   if (!(cell_size > 0) || !std::isfinite(cell_size))
     throw InputError("simulation cell size must be positive, got " + std::to_string(cell_size * 1e3) + " mm");
+  if (scene.prone.T.rows() == 0) {  // a prone surface not meshed yet: meshed once, at this size
+    if (!scene.prone_source) throw InputError(scene.path + ": the scene has no prone model to mesh");
+    Scene out = scene;
+    mesh_prone(out, cell_size);
+    return out;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<int> surface_index;
   const SurfaceMesh surface = boundary_surface(scene.prone, nullptr, &surface_index);

@@ -713,6 +713,16 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   EXPECT_EQ(l.prone.T.rows(), 0);
   ASSERT_TRUE(l.prone_source.has_value());
   EXPECT_EQ(l.prone_source->cell_size.value_or(0), 0.012);
+  RegistrationOptions at12 = preset_options("balanced");
+  at12.simulation_cell_size = 0.012;
+  // Its simulation scene is the surface meshed at that size (before, the empty model's boundary
+  // went to CGAL, which crashed on it).
+  const std::optional<Scene> meshed_for_simulation = simulation_scene(l, at12);
+  ASSERT_TRUE(meshed_for_simulation.has_value());
+  EXPECT_TRUE(meshed_for_simulation->tetrahedralized);
+  EXPECT_NEAR(static_cast<double>(meshed_for_simulation->prone.T.rows()), static_cast<double>(s.prone.T.rows()),
+              0.02 * s.prone.T.rows());
+  EXPECT_EQ(meshed_for_simulation->landmark_anchors.size(), s.landmark_anchors.size());
   // A size in millimetres is the preset's size in metres to the bit: 9 * 1e-3 is not 0.009, and
   // CGAL meshed other tetrahedra for it than for the balanced preset's nodal 9 mm.
   const Scene nine = load_scene(scene_with(
@@ -724,8 +734,6 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
   EXPECT_TRUE(l.tetrahedralized);
   EXPECT_NEAR(static_cast<double>(l.prone.T.rows()), static_cast<double>(s.prone.T.rows()), 0.02 * s.prone.T.rows());
   EXPECT_EQ(l.landmark_anchors.size(), s.landmark_anchors.size());
-  RegistrationOptions at12 = preset_options("balanced");
-  at12.simulation_cell_size = 0.012;
   EXPECT_FALSE(simulation_scene(l, at12).has_value());
 
   // The same surface as a modelling tool may export it: every 7th face flipped, and then the

@@ -48,6 +48,9 @@ TEST(Tetrahedralize, BadOptionsAreRejected) {
   opt.cell_size = 0.01;
   opt.radius_edge_ratio = 0.5;
   btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); }, "radius_edge_ratio");
+  opt.radius_edge_ratio = 2;
+  // No surface at all (CGAL's domain crashed on it, e.g. an unmeshed scene's empty prone model)
+  btr::test::expect_throw_with<InputError>([&] { tetrahedralize(SurfaceMesh{}, opt); }, "the surface has 0 faces");
 }
 
 // Landmarks are given as vertex indices of the input surface; Mesh_3 remeshes the boundary,

@@ -12,8 +12,9 @@ namespace btr {
 /// The scene with its prone model re-tetrahedralized at `cell_size` [m]: the chest wall is
 /// found again on the new boundary and the landmarks are re-attached as barycentric anchors,
 /// the cell labels carried over (transfer_cell_labels);
-/// all other data is unchanged (prepare_model embeds the tumours in the new mesh). Throws
-/// InputError for cell_size <= 0 or a prone boundary that cannot be meshed.
+/// all other data is unchanged (prepare_model embeds the tumours in the new mesh). A scene whose
+/// prone surface is not meshed yet is meshed at `cell_size` (mesh_prone). Throws InputError for
+/// cell_size <= 0 or a prone boundary that cannot be meshed.
 Scene with_simulation_mesh(const Scene& scene, double cell_size);
 
 /// Tetrahedralizes a scene's prone surface (s.prone_source) at cell_size [m] and attaches the
