@@ -174,18 +174,18 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   EXPECT_EQ(RegistrationEngine(prone_rest).prepare(balanced).model.volume_form, VolumeForm::Element);
 }
 
-// With its nodal form the balanced preset unloads with quadratic elements, where the scene does
-// not state the unload's elements; a stated order wins, and a preset without the nodal form (or
-// a scene that keeps the prone shape) unloads as the scene says. The engine keeps one entry per
+// With their nodal form the balanced and accurate presets unload with quadratic elements, where
+// the scene does not state the unload's elements; a stated order wins, and a preset without the
+// nodal form (fast, or a scene that keeps the prone shape) unloads as the scene says. The engine keeps one entry per
 // mesh and unload order, so a call's model does not depend on which preset asked first.
-TEST(Engine, TheBalancedPresetUnloadsWithQuadraticElementsWhereTheSceneLeavesItOpen) {
+TEST(Engine, APresetsNodalFormUnloadsWithQuadraticElementsWhereTheSceneLeavesItOpen) {
   Scene s = btr::test::coarse_phantom_scene();
   s.prone_gravity = Vec3(0, 0, 9.81);
   ASSERT_FALSE(s.unload_element_order_stated);
   const RegistrationOptions balanced = preset_options("balanced"), fast = preset_options("fast");
   EXPECT_EQ(preset_unload_elements(s, balanced), ElementOrder::Quadratic);
   EXPECT_EQ(preset_unload_elements(s, fast), ElementOrder::Linear);
-  EXPECT_EQ(preset_unload_elements(s, preset_options("accurate")), ElementOrder::Linear);
+  EXPECT_EQ(preset_unload_elements(s, preset_options("accurate")), ElementOrder::Quadratic);
   Scene stated = s;
   stated.unload_element_order_stated = true;  // material.unload_element_order: linear
   EXPECT_EQ(preset_unload_elements(stated, balanced), ElementOrder::Linear);

@@ -31,8 +31,9 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
 /// one commercial 10-node tetrahedra use (it integrates the P2 stiffness of a straight element
 /// exactly). Against the 14-point degree-5 rule on the 15 scenes of the balanced preset's choice
 /// the worst tumour moved by at most 0.001 mm on 13, came nearer on 2 (by 0.088 and 0.007 mm),
-/// and the call took 0.83 to 0.92 times as long (BENCHMARKS.md, "The quadratic unload's
-/// quadrature"). Truth generators keep the 14-point rule (ForwardGravityOptions' default).
+/// and the unload step took a median 0.75 times as long, the call 0.87 (BENCHMARKS.md, "The
+/// accurate preset on balanced's model, and the unload's 4-point rule"). Truth generators keep
+/// the 14-point rule (ForwardGravityOptions' default).
 constexpr int kUnloadQuadratureDegree = 2;
 
 /// `options` with the model's elements for the forward solves (MaterialParameters::unload_element_order)
