@@ -66,10 +66,11 @@ namespace {
 // unloads with quadratic elements (2026-12-07: nearer on 11 of 15 scenes, 7 chosen on and 8 made
 // after, within 0.003 mm on the rest, at a median 2.2 times the call; at accurate's 5 mm it
 // gained nothing consistent; BENCHMARKS.md, "The quadratic unload in the balanced preset").
-// Accurate then ended farther than balanced on 8 of those 15 scenes at 5.9 times its time; with
+// Accurate then ended farther than balanced on 9 of those 15 scenes at 5.9 times its time; with
 // balanced's model at 7 mm (nodal, quadratic unload) and its own tolerances it is nearer than the
-// 5 mm point on 10 of 15 at 0.44 times its time, and nearer than balanced on 9 at 2.6 times
-// (2026-12-07, fourth session; BENCHMARKS.md, "The accurate preset on balanced's model").
+// 5 mm point on 11 of 15 at 0.46 times its time, and nearer than balanced on 9 at 2.7 times
+// (2026-12-07, fourth session; BENCHMARKS.md, "The accurate preset on balanced's model, and the
+// unload's 4-point rule").
 struct Preset {
   const char* name;
   double simulation_cell_size;    ///< [m]; 0: the scene's own mesh

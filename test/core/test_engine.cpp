@@ -176,8 +176,9 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
 
 // With their nodal form the balanced and accurate presets unload with quadratic elements, where
 // the scene does not state the unload's elements; a stated order wins, and a preset without the
-// nodal form (fast, or a scene that keeps the prone shape) unloads as the scene says. The engine keeps one entry per
-// mesh and unload order, so a call's model does not depend on which preset asked first.
+// nodal form (fast, or a scene that keeps the prone shape) unloads as the scene says. The engine
+// keeps one entry per mesh and unload order, so a call's model does not depend on which preset
+// asked first.
 TEST(Engine, APresetsNodalFormUnloadsWithQuadraticElementsWhereTheSceneLeavesItOpen) {
   Scene s = btr::test::coarse_phantom_scene();
   s.prone_gravity = Vec3(0, 0, 9.81);

@@ -40,7 +40,8 @@ struct RegistrationOptions {
   /// The preset's elements for the unloaded shape, taken with its nodal form (where
   /// takes_preset_volume_form) when the scene does not state material.unload_element_order
   /// (preset_unload_elements). Balanced and accurate: quadratic (BENCHMARKS.md, "The quadratic
-  /// unload as the balanced preset's default", "The accurate preset on balanced's model").
+  /// unload as the balanced preset's default"; "The accurate preset on balanced's model, and the
+  /// unload's 4-point rule").
   ElementOrder unload_element_order = ElementOrder::Linear;
   /// > 0: the simulation cell size [m] where the preset's nodal form is taken (the nodal form is
   /// the costlier per tetrahedron and locks less, so its point on the front is a coarser mesh)

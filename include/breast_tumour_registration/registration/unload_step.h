@@ -25,8 +25,6 @@ class StepSolvers;
 StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, const UnloadOptions& options = {},
                         StepSolvers* cache = nullptr);
 
-/// The unload problem of `model`'s mesh, chest wall and materials for the imaged shape `loaded`
-/// (its vertices: model.prone, kept alive by the caller) under `gravity` [m/s^2].
 /// The quadrature of the unload's quadratic elements (tet_quadrature): Keast's 4-point rule, the
 /// one commercial 10-node tetrahedra use (it integrates the P2 stiffness of a straight element
 /// exactly). Against the 14-point degree-5 rule on the 15 scenes of the balanced preset's choice
@@ -36,8 +34,10 @@ StepReport unload_model(RegistrationModel& model, const Vec3& prone_gravity, con
 /// the 14-point rule (ForwardGravityOptions' default).
 constexpr int kUnloadQuadratureDegree = 2;
 
-/// `options` with the model's elements for the forward solves (MaterialParameters::unload_element_order)
-/// and, for quadratic ones, kUnloadQuadratureDegree.
+/// The unload problem of `model`'s mesh, chest wall and materials for the imaged shape `loaded`
+/// (its vertices: model.prone, kept alive by the caller) under `gravity` [m/s^2].
+/// with_model_elements: `options` with the model's elements for the forward solves
+/// (MaterialParameters::unload_element_order) and, for quadratic ones, kUnloadQuadratureDegree.
 UnloadOptions with_model_elements(UnloadOptions options, const RegistrationModel& model);
 UnloadProblem unload_problem(const RegistrationModel& model, const TetMesh& loaded, const Vec3& gravity);
 
