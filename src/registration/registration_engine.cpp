@@ -101,7 +101,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
   const VolumeForm form =
       preset_form ? VolumeForm::Nodal : resolve_volume_form(scene_.material.volume_form, scene_.material.poisson_ratio);
   RegistrationOptions mesh_opt = opt;  // with the mesh the preset simulates its nodal form on
-  if (preset_form && opt.nodal_simulation_cell_size > 0) mesh_opt.simulation_cell_size = opt.nodal_simulation_cell_size;
+  mesh_opt.simulation_cell_size = simulation_cell_size_for(scene_, opt);
   // The key is the mesh the call simulates (the size a prone surface is meshed at, the preset's
   // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given) and the
   // elements it is unloaded with. The first call on a mesh prepares it with its form; the other

@@ -119,6 +119,11 @@ bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt
          scene.prone_gravity.has_value();
 }
 
+double simulation_cell_size_for(const Scene& scene, const RegistrationOptions& opt) {
+  return takes_preset_volume_form(scene, opt) && opt.nodal_simulation_cell_size > 0 ? opt.nodal_simulation_cell_size
+                                                                                    : opt.simulation_cell_size;
+}
+
 ElementOrder preset_unload_elements(const Scene& scene, const RegistrationOptions& opt) {
   return takes_preset_volume_form(scene, opt) && !scene.unload_element_order_stated ? opt.unload_element_order
                                                                                     : scene.material.unload_element_order;

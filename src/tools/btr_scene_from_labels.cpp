@@ -28,8 +28,10 @@ int main(int argc, char** argv) {
   app.add_option("label_map", label_map, "prone label map: .nii, .nii.gz, .nrrd, .nhdr or .seg.nrrd")->required();
   app.add_option("--labels", table_path, "label table (YAML): which label value or segment name is which tissue");
   app.add_option("-o,--out", out_dir, "scene folder (created)")->capture_default_str();
-  auto* cell_opt = app.add_option("--cell-size", cell_mm, "tetrahedron size bound [mm]; default: the preset's simulation mesh "
-                                                            "(fast 9, balanced 7, accurate 4), which the preset then simulates as it is")
+  auto* cell_opt = app.add_option("--cell-size", cell_mm,
+                                  "tetrahedron size bound [mm]; default: the mesh the preset simulates, so it simulates this "
+                                  "one as it is (a prone image, which is unloaded: fast 9, balanced 9, accurate 7 with "
+                                  "the nodal form; --not-prone: 9, 7, 4)")
                        ->check(btr::cli::positive());
   app.add_option("--tumour-facet-size", tumour_facet_mm, "facet size bound on the tumours' surfaces [mm]")
       ->capture_default_str()
@@ -49,9 +51,13 @@ int main(int argc, char** argv) {
   app.add_flag("--no-features", no_features, "do not protect the lines where three labels meet");
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
-    // The preset's own mesh size, so that the registration simulates this mesh as it is.
+    // The mesh the preset simulates this scene on, so that the registration simulates it as it
+    // is: a prone image is unloaded (prone_gravity), where balanced and accurate take their nodal
+    // form on its own mesh (before, balanced re-meshed a 7 mm label mesh at 9 mm).
     if (!cell_opt->count()) {
-      const double preset_cell = preset_options(preset).simulation_cell_size;
+      Scene written;  // as write_scene_from_labels writes it: volume form auto, prone_gravity for a prone image
+      if (!not_prone) written.prone_gravity = Vec3(0, 0, -9.81);
+      const double preset_cell = simulation_cell_size_for(written, preset_options(preset));
       cell_mm = preset_cell > 0 ? preset_cell * 1e3 : 7.0;
     }
     const LabelVolume v = read_label_volume(label_map);

@@ -136,6 +136,13 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   RegistrationOptions nodal = balanced;
   nodal.nodal_simulation_cell_size = 0.025;  // coarser than this 12 mm mesh: re-tetrahedralized
   EXPECT_TRUE(takes_preset_volume_form(s, nodal));
+  // The mesh a call asks for is the nodal form's where the preset takes it (a mesh made at that
+  // size, e.g. by btr_scene_from_labels, is simulated as it is), else the preset's element mesh.
+  EXPECT_EQ(simulation_cell_size_for(s, nodal), 0.025);
+  EXPECT_EQ(simulation_cell_size_for(s, by_poisson), balanced.simulation_cell_size);
+  Scene not_unloading = s;
+  not_unloading.prone_gravity.reset();
+  EXPECT_EQ(simulation_cell_size_for(not_unloading, nodal), balanced.simulation_cell_size);
 
   RegistrationEngine engine(s);
   const RegistrationResult r = engine.solve(nodal);

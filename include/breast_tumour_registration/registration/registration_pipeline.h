@@ -77,6 +77,12 @@ struct RegistrationOptions {
 /// the preset asks for the nodal form.
 bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt);
 
+/// The simulation cell size [m] a registration of `scene` with `opt` asks for: the preset's
+/// nodal_simulation_cell_size where it takes its nodal form (takes_preset_volume_form), else
+/// opt.simulation_cell_size (0: the scene's mesh as given). A mesh made at this size is simulated
+/// as it is (RegistrationEngine, btr_scene_from_labels).
+double simulation_cell_size_for(const Scene& scene, const RegistrationOptions& opt);
+
 /// The elements `scene` is unloaded with in a registration with `opt`: the preset's
 /// (RegistrationOptions::unload_element_order) where it takes its nodal form and the scene does
 /// not state them, else the scene's material.unload_element_order.
