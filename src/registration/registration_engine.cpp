@@ -120,13 +120,10 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
   const auto t0 = std::chrono::steady_clock::now();
   auto e = std::make_unique<Entry>();
   PreparedScene& p = e->prepared;
-  if (unmeshed) {
-    p.scene = scene_;
-    mesh_prone(p.scene, key);
-    p.mesh_note = "tetrahedralized the prone surface at " + millimetres(key);
-  } else if (key > 0) {
+  if (key > 0) {  // with_simulation_mesh meshes an unmeshed prone surface, else re-meshes the model
     p.scene = with_simulation_mesh(scene_, key);
-    p.mesh_note = "re-tetrahedralized the prone model at " + millimetres(key);
+    p.mesh_note = (unmeshed ? "tetrahedralized the prone surface at " : "re-tetrahedralized the prone model at ") +
+                  millimetres(key);
   } else {
     p.scene = scene_;
   }
