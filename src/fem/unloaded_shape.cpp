@@ -124,7 +124,8 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
       X_prev = Xv;
       f_prev = fv;
       Eigen::VectorXd next = Xv + fv;
-      if (opt.anderson_depth > 0 && !dF.empty()) {
+      const bool accelerated = opt.anderson_depth > 0 && !dF.empty();
+      if (accelerated) {
         Eigen::MatrixXd Fm(fv.size(), static_cast<Eigen::Index>(dF.size())), Xm(fv.size(), static_cast<Eigen::Index>(dX.size()));
         for (size_t j = 0; j < dF.size(); ++j) {
           Fm.col(static_cast<Eigen::Index>(j)) = dF[j];
@@ -134,20 +135,27 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
         next -= (Xm + Fm) * gamma;
       }
       // The candidate, then (if its forward solve fails or its rest shape inverts an element) the
-      // plain fixed-point step with the Anderson history dropped, then that step halved.
+      // plain fixed-point step with the Anderson history dropped (unless the candidate was that
+      // step already), then that step halved.
       bool moved = false;
+      int tried = 0, inverting = 0;
       for (int attempt = 0; attempt < 5 && !moved; ++attempt) {
         if (attempt == 1) {
+          if (!accelerated) continue;
           dX.clear();
           dF.clear();
           next = Xv + fv;
         } else if (attempt > 1) {
           next = Xv + std::pow(0.5, attempt - 1) * fv;
         }
+        ++tried;
         Points Xc = Eigen::Map<const Points>(next.data(), nv, 3);
         for (Eigen::Index v = 0; v < nv; ++v)
           if (fixed[v]) Xc.row(v) = xp.row(v);
-        if (count_inverted(Xc, loaded.T) > 0) continue;
+        if (count_inverted(Xc, loaded.T) > 0) {
+          ++inverting;
+          continue;
+        }
         // Warm start: the last equilibrium's displacement applied to the new rest shape; if that
         // stalls, a cold start from the rest shape itself.
         for (const bool warm : {true, false}) {
@@ -160,9 +168,17 @@ UnloadResult estimate_unloaded_shape(const UnloadProblem& pb, const UnloadOption
         }
       }
       if (!moved) {
-        st.reason = spent() ? budget_spent + ", mismatch " + format_mm(st.best, 3)
-                            : "no forward solve converged from the next estimate, nor from a plain or halved step; mismatch " +
-                                  format_mm(st.best, 3);
+        // A step whose rest shape inverts an element is not solved at all: where every one does,
+        // no forward solve failed; the estimate cannot move on without an inverted rest element.
+        if (spent())
+          st.reason = budget_spent + ", mismatch " + format_mm(st.best, 3);
+        else if (inverting == tried)
+          st.reason = "every step towards the next estimate (the plain one, halved down to 1/8) inverts a rest element "
+                      "(the rest shape this model needs may have inverted elements); mismatch " + format_mm(st.best, 3);
+        else
+          st.reason = "no forward solve converged from the next estimate, nor from a plain or halved step (" +
+                      std::to_string(inverting) + " of the " + std::to_string(tried) +
+                      " steps invert a rest element); mismatch " + format_mm(st.best, 3);
         break;
       }
     }

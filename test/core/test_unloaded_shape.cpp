@@ -10,6 +10,7 @@
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/tet_kinematics.h"
 #include "breast_tumour_registration/fem/unloaded_shape.h"
+#include "breast_tumour_registration/geometry/box_mesh.h"
 #include "breast_tumour_registration/simulation/phantom.h"
 #include "breast_tumour_registration/simulation/phantom_scene.h"
 
@@ -121,6 +122,37 @@ TEST(Unload, AForwardSolveBudgetStopsItAndSaysSo) {
   expect_cut(continued, opt.max_forward_solves);
   opt.max_forward_solves = -1;
   EXPECT_THROW(estimate_unloaded_shape(pb, opt), InputError);
+}
+
+// Where every step of the fixed point inverts a rest element, no forward solve is tried and the
+// reason says so (it said "no forward solve converged" before, which none had failed; the
+// phantom's 400 Pa quadratic truth, meshed at 9 mm, stops the quadratic unload this way). A
+// 5 mm slab fixed at its base, imaged hanging upwards under its own weight: at 10 Pa its rest
+// shape exists; at 5 Pa the weight stretches it by about 47 mm, so the rest shape it needs lies
+// below its own base.
+TEST(Unload, WhereEveryStepInvertsARestElementTheReasonSaysSo) {
+  const TetMesh slab = make_box_tet_mesh(2, 2, 1, Vec3(0.02, 0.02, 0.005));
+  UnloadProblem pb;
+  pb.loaded = &slab;
+  for (Eigen::Index v = 0; v < slab.V.rows(); ++v)
+    if (slab.V(v, 2) < 1e-9) pb.fixed.push_back(static_cast<int>(v));
+  pb.volume_form = VolumeForm::Element;
+  pb.gravity = Vec3(0, 0, 9.81);
+  UnloadOptions opt;
+  opt.max_stages = 0;
+  pb.materials = {StableNeoHookean(10, 0.3)};
+  const UnloadResult exists = estimate_unloaded_shape(pb, opt);
+  EXPECT_TRUE(exists.converged) << exists.stop_reason;
+  pb.materials = {StableNeoHookean(5, 0.3)};
+  const UnloadResult r = estimate_unloaded_shape(pb, opt);
+  std::printf("5 Pa slab: %s\n", r.stop_reason.c_str());
+  EXPECT_FALSE(r.converged);
+  EXPECT_NE(r.stop_reason.find("every step towards the next estimate (the plain one, halved down to 1/8) inverts a rest element"),
+            std::string::npos) << r.stop_reason;
+  EXPECT_EQ(r.stop_reason.find("no forward solve converged"), std::string::npos) << r.stop_reason;
+  EXPECT_EQ(r.iterations, 2);  // the inverse-gravity lift and the first forward solve; no step was solved
+  EXPECT_GT(r.max_mismatch, 0.03);
+  EXPECT_EQ(count_inverted(r.rest, slab.T), 0);
 }
 
 // Softer than anything that could have made the shape: the 200 Pa prone shape unloaded with a
