@@ -30,8 +30,8 @@ int main(int argc, char** argv) {
   app.add_option("-o,--out", out_dir, "scene folder (created)")->capture_default_str();
   auto* cell_opt = app.add_option("--cell-size", cell_mm,
                                   "tetrahedron size bound [mm]; default: the mesh the preset simulates, so it simulates this "
-                                  "one as it is (a prone image, which is unloaded: fast 9, balanced 9, accurate 7 with "
-                                  "the nodal form; --not-prone: 9, 7, 4)")
+                                  "one as it is (a prone image, which is unloaded, with the nodal form: fast 11, balanced 9, "
+                                  "accurate 7; --not-prone: 9, 7, 4)")
                        ->check(btr::cli::positive());
   app.add_option("--tumour-facet-size", tumour_facet_mm, "facet size bound on the tumours' surfaces [mm]")
       ->capture_default_str()
