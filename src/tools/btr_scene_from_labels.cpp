@@ -52,8 +52,8 @@ int main(int argc, char** argv) {
   if (const int rc = btr::cli::parse(app, argc, argv); rc >= 0) return rc;
   try {
     // The mesh the preset simulates this scene on, so that the registration simulates it as it
-    // is: a prone image is unloaded (prone_gravity), where balanced and accurate take their nodal
-    // form on its own mesh (before, balanced re-meshed a 7 mm label mesh at 9 mm).
+    // is: a prone image is unloaded (prone_gravity), where the presets take their nodal form on
+    // its own mesh (before, balanced re-meshed a 7 mm label mesh at 9 mm).
     if (!cell_opt->count()) {
       Scene written;  // as write_scene_from_labels writes it: volume form auto, prone_gravity for a prone image
       if (!not_prone) written.prone_gravity = Vec3(0, 0, -9.81);
