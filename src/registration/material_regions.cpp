@@ -1,12 +1,25 @@
 #include "breast_tumour_registration/registration/material_regions.h"
 
+#include <algorithm>
+#include <cstdio>
+
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/metrics.h"
+#include "breast_tumour_registration/geometry/validation.h"
 
 namespace btr {
 
-void assign_material_regions(RegistrationModel& model, const std::vector<MaterialRegion>& regions,
-                             const std::vector<int>& labels) {
+double partial_volume_youngs_modulus(double matrix, double inclusion, double fraction) {
+  if (!(matrix > 0) || !(inclusion > 0) || !(fraction >= 0 && fraction <= 1))
+    throw InputError("partial volume: moduli must be > 0 and the fraction in [0, 1]");
+  if (inclusion == matrix) return matrix;
+  return matrix * (1 + fraction / (matrix / (inclusion - matrix) + 0.4 * (1 - fraction)));
+}
+
+std::vector<std::string> assign_material_regions(RegistrationModel& model, const std::vector<MaterialRegion>& regions,
+                                                 const std::vector<int>& labels) {
+  std::vector<std::string> notes;
   const Eigen::Index nt = model.rest.T.rows();
   if (!labels.empty() && static_cast<Eigen::Index>(labels.size()) != nt)
     throw InputError("regions: " + std::to_string(labels.size()) + " cell labels for " + std::to_string(nt) + " tetrahedra");
@@ -23,9 +36,27 @@ void assign_material_regions(RegistrationModel& model, const std::vector<Materia
         throw InputError("regions '" + r.name + "': no tetrahedron carries label " + std::to_string(*r.label));
     } else {
       // Given on the prone image: the centroids are taken at the prone positions.
-      members = tetrahedra_inside(TetMesh{model.prone, model.rest.T}, {&*r.surface});
-      if (members.empty())
-        throw InputError("regions '" + r.name + "': no tetrahedron centroid lies inside its surface; refine the mesh");
+      const TetMesh prone{model.prone, model.rest.T};
+      members = tetrahedra_inside(prone, {&*r.surface});
+      if (members.empty()) {
+        // Smaller than the mesh resolves: the tetrahedron holding the region's centroid takes a
+        // mixture of its material and the region's by the region's share of its volume.
+        const Points centroid = volume_centroid(*r.surface).transpose();
+        const int t = embed_points(prone, centroid).tet[0];
+        const double share = std::min(1.0, std::abs(enclosed_volume(*r.surface)) / std::abs(tet_signed_volume(prone.V, prone.T, t)));
+        const StableNeoHookean& around = model.materials[static_cast<size_t>(model.material_of[t])];
+        const double E = partial_volume_youngs_modulus(around.youngs_modulus(), r.youngs_modulus, share);
+        model.materials.push_back(StableNeoHookean(E, model.material.poisson_ratio));
+        model.material_names.push_back(r.name + " (partial volume)");
+        model.material_tetrahedra.push_back(0);
+        model.material_of[t] = static_cast<int>(model.materials.size()) - 1;
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "%.2g %% of the tetrahedron holding its centroid, whose E becomes %.0f Pa (%.0f Pa before)",
+                      100 * share, E, around.youngs_modulus());
+        notes.push_back("regions '" + r.name + "': no tetrahedron centroid lies inside its surface (the mesh is coarser "
+                        "than the region); it is " + buf + ". A finer --cell-size resolves it");
+        continue;
+      }
     }
     const int index = static_cast<int>(model.materials.size());
     model.materials.push_back(StableNeoHookean(r.youngs_modulus, model.material.poisson_ratio));
@@ -34,6 +65,7 @@ void assign_material_regions(RegistrationModel& model, const std::vector<Materia
     for (int t : members) model.material_of[t] = index;
   }
   count_material_tetrahedra(model);
+  return notes;
 }
 
 std::vector<int> transfer_cell_labels(const TetMesh& from, const std::vector<int>& labels, const TetMesh& to) {

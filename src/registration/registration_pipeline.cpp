@@ -220,7 +220,7 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
                          std::to_string(m.tumours.back().embedding.max_outside_distance * 1e3) +
                          " mm); they follow the nearest tetrahedron");
   }
-  assign_material_regions(m, scene.regions, scene.prone_labels);
+  for (std::string& note : assign_material_regions(m, scene.regions, scene.prone_labels)) warnings.push_back(std::move(note));
   if (scene.tumour_youngs_modulus) {
     stiffen_tumours(m, *scene.tumour_youngs_modulus);
     if (m.stiff_tetrahedra == 0)

@@ -152,6 +152,38 @@ TEST(MaterialRegions, BadRegionsAreClearErrors) {
   expect_throw_with<InputError>([&] { load_meshed_scene(surf); }, "needs prone.tet_mesh");
 }
 
+// A region smaller than the mesh resolves (a small tumour on a preset's 9 or 11 mm mesh) used to
+// fail the call ("no tetrahedron centroid lies inside its surface; refine the mesh"). Now the
+// tetrahedron holding its centroid takes the partial-volume mixture, and a warning says so.
+TEST(MaterialRegions, ARegionSmallerThanTheMeshStiffensTheTetrahedronHoldingItByItsShare) {
+  EXPECT_EQ(partial_volume_youngs_modulus(1000, 8000, 0), 1000);
+  EXPECT_NEAR(partial_volume_youngs_modulus(1000, 8000, 1), 8000, 1e-9);
+  EXPECT_EQ(partial_volume_youngs_modulus(1000, 1000, 0.3), 1000);
+  EXPECT_NEAR(partial_volume_youngs_modulus(1000, 1e15, 0.01), 1000 * (1 + 2.5 * 0.01 / 0.99), 1e-6);  // Einstein's dilute limit
+  const double half = partial_volume_youngs_modulus(1000, 8000, 0.5);
+  EXPECT_GT(half, 1000);
+  EXPECT_LT(half, 0.5 * (1000 + 8000));  // below the volume average: a stiff inclusion in a soft matrix
+  EXPECT_THROW(partial_volume_youngs_modulus(1000, 8000, 1.5), InputError);
+
+  // A speck of 1 mm (a tumour's surface shrunk about its centroid) on the 12 mm phantom.
+  SurfaceMesh speck = read_surface(labelled_phantom_dir() + "/tumour_top_prone.obj", LengthUnit::Millimetre);
+  const Eigen::RowVector3d c = speck.V.colwise().mean();
+  speck.V = (speck.V.rowwise() - c) * (1e-3 / (speck.V.colwise().maxCoeff() - speck.V.colwise().minCoeff()).maxCoeff());
+  speck.V.rowwise() += c;
+  write_surface(labelled_phantom_dir() + "/speck_prone.obj", speck, LengthUnit::Millimetre);
+  const Scene s = load_meshed_scene(scene_variant("speck", "regions: [{name: speck, surface: speck_prone.obj, youngs_modulus: 34000}]"));
+  std::vector<std::string> w;
+  const RegistrationModel m = prepare_model(s, w);
+  ASSERT_EQ(m.material_names.back(), "speck (partial volume)");
+  EXPECT_EQ(m.material_tetrahedra.back(), 1);
+  const double E = youngs_modulus(m.materials.back());
+  EXPECT_GT(E, 3400);
+  EXPECT_LT(E, 3400 * 1.05);  // 1 mm^3 of a tetrahedron of the 12 mm mesh
+  ASSERT_FALSE(w.empty());
+  EXPECT_NE(w.back().find("regions 'speck': no tetrahedron centroid lies inside its surface"), std::string::npos) << w.back();
+  EXPECT_NE(w.back().find("A finer --cell-size resolves it"), std::string::npos) << w.back();
+}
+
 TEST(MaterialRegions, AnEstimatedStiffnessScalesEveryRegion) {
   // Relative stiffness: the estimate moves the body's E and the regions keep their ratios.
   const std::string path = labelled_phantom_dir() + "/estimate.yaml";

@@ -2,6 +2,7 @@
 // material (MaterialParameters) holds everywhere a region does not.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "breast_tumour_registration/fem/material_region.h"
@@ -12,10 +13,19 @@ namespace btr {
 /// Gives each region's tetrahedra of the model the region's material (later regions win where
 /// they overlap), appending one material per region to model.materials and counting them in
 /// model.material_tetrahedra. `labels`: one per tetrahedron of the model's mesh (empty when the
-/// mesh has none). InputError for a label region without labels, a label no tetrahedron
-/// carries, or a surface region with no centroid inside (the mesh is too coarse for it).
-void assign_material_regions(RegistrationModel& model, const std::vector<MaterialRegion>& regions,
-                             const std::vector<int>& labels);
+/// mesh has none). A surface region with no tetrahedron centroid inside (smaller than the mesh
+/// resolves: a small tumour on a preset's 9 or 11 mm mesh) gives the tetrahedron holding its
+/// centroid the partial-volume mixture of that tetrahedron's material and its own, and a note
+/// (returned, for the warnings); before, it was an error. InputError for a label region without
+/// labels or a label no tetrahedron carries.
+std::vector<std::string> assign_material_regions(RegistrationModel& model, const std::vector<MaterialRegion>& regions,
+                                                 const std::vector<int>& labels);
+
+/// Young's modulus of a tetrahedron of `matrix` [Pa] holding a `fraction` of its volume of an
+/// `inclusion` [Pa]: the Hashin-Shtrikman bound with the matrix as reference for nearly
+/// incompressible phases (the dilute estimate for a spherical inclusion, E (1 + 2.5 f) for a
+/// rigid one; the volume average would give a stiff one's whole modulus times its share).
+double partial_volume_youngs_modulus(double matrix, double inclusion, double fraction);
 
 /// Cell labels of `from` carried to the tetrahedra of `to` (another mesh of the same body,
 /// e.g. the simulation mesh): each takes the label of the tetrahedron of `from` holding its
