@@ -11,22 +11,20 @@
 # Usage: bash run.sh candidates|preset|draws OUT NAME=SCENE.yaml ...
 set -uo pipefail
 source "$(dirname "$0")/../../preset_runs.sh"
-MODE=$1; OUT=$2; shift 2
-jobs=()
-for spec in "$@"; do
-  name=${spec%%=*}; scene=${spec#*=}
-  case "$MODE" in
+jobs_for() {  # MODE NAME SCENE
+  local q l c
+  case "$1" in
     candidates)
-      q=$(scene_copy "$scene" "acc_quadratic_$name" unload_element_order quadratic)
-      jobs+=("bal $name $scene --preset balanced" "acc5 $name $scene --preset accurate"
-             "acc9q $name $q --preset accurate --cell-size 9" "acc7q $name $q --preset accurate --cell-size 7") ;;
-    preset) jobs+=("accnew $name $scene --preset accurate") ;;
+      q=$(scene_copy "$3" "acc_quadratic_$2" unload_element_order quadratic)
+      jobs+=("bal $2 $3 --preset balanced" "acc5 $2 $3 --preset accurate"
+             "acc9q $2 $q --preset accurate --cell-size 9" "acc7q $2 $q --preset accurate --cell-size 7") ;;
+    preset) jobs+=("accnew $2 $3 --preset accurate") ;;
     draws)
-      l=$(scene_copy "$scene" "acc_linear_$name" unload_element_order linear)
-      for c in 8.91 9.09; do jobs+=("bal_$c $name $scene --preset balanced --cell-size $c"); done
-      for c in 6.93 7.07; do jobs+=("acc_$c $name $scene --preset accurate --cell-size $c"); done
-      for c in 4.95 5.05; do jobs+=("acc5_$c $name $l --preset accurate --cell-size $c"); done ;;
-    *) echo "mode: candidates, preset or draws" >&2; exit 2 ;;
+      l=$(scene_copy "$3" "acc_linear_$2" unload_element_order linear)
+      for c in 8.91 9.09; do jobs+=("bal_$c $2 $3 --preset balanced --cell-size $c"); done
+      for c in 6.93 7.07; do jobs+=("acc_$c $2 $3 --preset accurate --cell-size $c"); done
+      for c in 4.95 5.05; do jobs+=("acc5_$c $2 $l --preset accurate --cell-size $c"); done ;;
+    *) echo "mode: candidates, preset or draws" >&2; return 1 ;;
   esac
-done
-run_jobs "$OUT" "${jobs[@]}"
+}
+study_main "$@"

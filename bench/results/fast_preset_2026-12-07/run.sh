@@ -9,20 +9,18 @@
 # Usage: bash run.sh candidates|draws OUT NAME=SCENE.yaml ...
 set -uo pipefail
 source "$(dirname "$0")/../../preset_runs.sh"
-MODE=$1; OUT=$2; shift 2
-jobs=()
-for spec in "$@"; do
-  name=${spec%%=*}; scene=${spec#*=}
-  case "$MODE" in
+jobs_for() {  # MODE NAME SCENE
+  local c e
+  case "$1" in
     candidates)
-      c=$(scene_copy "$scene" "fast_nodal_$name" volume_form nodal)
-      jobs+=("fast $name $scene --preset fast" "fastn9 $name $c --preset fast"
-             "fastn11 $name $c --preset fast --cell-size 11" "bal $name $scene --preset balanced") ;;
+      c=$(scene_copy "$3" "fast_nodal_$2" volume_form nodal)
+      jobs+=("fast $2 $3 --preset fast" "fastn9 $2 $c --preset fast"
+             "fastn11 $2 $c --preset fast --cell-size 11" "bal $2 $3 --preset balanced") ;;
     draws)
-      e=$(scene_copy "$scene" "fast_element_$name" volume_form element)
-      for c in 10.89 11.11; do jobs+=("draw_fastn11_$c $name $scene --preset fast --cell-size $c"); done
-      for c in 8.91 9.09; do jobs+=("draw_fast_$c $name $e --preset fast --cell-size $c"); done ;;
-    *) echo "mode: candidates or draws" >&2; exit 2 ;;
+      e=$(scene_copy "$3" "fast_element_$2" volume_form element)
+      for c in 10.89 11.11; do jobs+=("draw_fastn11_$c $2 $3 --preset fast --cell-size $c"); done
+      for c in 8.91 9.09; do jobs+=("draw_fast_$c $2 $e --preset fast --cell-size $c"); done ;;
+    *) echo "mode: candidates or draws" >&2; return 1 ;;
   esac
-done
-run_jobs "$OUT" "${jobs[@]}"
+}
+study_main "$@"
