@@ -5,12 +5,12 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <random>
 #include <utility>
 
 #include "breast_tumour_registration/base/errors.h"
+#include "breast_tumour_registration/base/units.h"
 #include "breast_tumour_registration/fem/volume_form.h"
 #include "breast_tumour_registration/geometry/vertex_normals.h"
 #include "breast_tumour_registration/registration/simulation_mesh.h"
@@ -21,11 +21,6 @@ namespace {
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-std::string millimetres(double m) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.1f mm", m * 1e3);
-  return b;
 }
 
 /// The prepared scene with the supine side of `supine`: everything run_registration reads from
@@ -123,7 +118,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
   if (key > 0) {  // with_simulation_mesh meshes an unmeshed prone surface, else re-meshes the model
     p.scene = with_simulation_mesh(scene_, key);
     p.mesh_note = (unmeshed ? "tetrahedralized the prone surface at " : "re-tetrahedralized the prone model at ") +
-                  millimetres(key);
+                  format_mm(key);
   } else {
     p.scene = scene_;
   }
