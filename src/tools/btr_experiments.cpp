@@ -37,10 +37,10 @@ int main(int argc, char** argv) {
                  "landmark_weight landmark_set");
   app.add_option("-E,--youngs-moduli", moduli, "generating Young's moduli [Pa] (default: the thesis's 16, 200-12000)")
       ->check(btr::cli::positive());
-  app.add_option("--model", model_path, "a rest model file (YAML, see rest_model_io.h) instead of the built-in phantom");
+  app.add_option("--model", model_path, "a rest model file (YAML; its fields: README.md, \"The rest model file\") instead of the built-in phantom");
   std::string truth_path;
   app.add_option("--truth", truth_path,
-                 "with --model: a truth file (YAML, see given_truth_io.h) of prone and supine configurations made "
+                 "with --model: a truth file (YAML; its fields: README.md, \"The truth file\") of prone and supine configurations made "
                  "elsewhere (another FEM code), run instead of generating them; -E picks among its moduli (default: "
                  "all of them)")
       ->needs(app.get_option("--model"));

@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
                                  "gives the prone model as its skin surface)");
   std::string volume_form = "auto";
   app.add_option("--volume-form", volume_form, "volume term of the generating material: auto, element or nodal "
-                                               "(auto: nodal from nu = 0.495 up; elastic_energy.h)")
+                                               "(auto: nodal from nu = 0.495 up; README.md, \"Material\")")
       ->capture_default_str();
   double nodal_element_share = 0;
   app.add_option("--nodal-element-share", nodal_element_share,

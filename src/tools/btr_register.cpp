@@ -42,13 +42,13 @@ int main(int argc, char** argv) {
                  "prone.cell_size_mm, else the preset's; 0: the scene's mesh as given)")
       ->check(btr::cli::non_negative());
   app.add_option("--uncertainty", uncertainty,
-                 "none; linear (experimental, not yet validated): each tumour centroid's covariance and 95 % radius "
+                 "none; linear (calibrated where the pose is solved with the deformation, over-wide where a chest ring sets it: README.md, issue 14): each tumour centroid's covariance and 95 % radius "
                  "from the Young's modulus, Poisson's ratio, the gravity direction, the depth noise, the rigid pose where "
-                 "ICP sets it and the landmarks where the pose is solved with the deformation (tumour_uncertainty.h); "
+                 "ICP sets it and the landmarks where the pose is solved with the deformation; "
                  "sampling: "
                  "the same from re-registrations with every source sampled (Young's modulus, Poisson's ratio, gravity "
                  "direction, landmarks, depth noise), beside the linear figures. The distributions are the scene's "
-                 "`uncertainty:` section, else the defaults (uncertainty_sources.h)")
+                 "`uncertainty:` section, else the defaults (README.md, \"The scene file\")")
       ->check(CLI::IsMember({"none", "linear", "sampling"}))
       ->capture_default_str();
   app.add_option("--samples", samples, "with --uncertainty sampling: re-registrations with sampled inputs (the linear "
