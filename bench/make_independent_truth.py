@@ -41,8 +41,16 @@ generator with other dimensions and tissue ratios, e.g. the deeper, narrower bre
 BENCHMARKS.md ("The nodal volume term as the default"):
   --depth 75 --half-width 65 60 --half-height 60 --sag -10 --gland-ratio 3 --tumour-ratio 8
 
+Tumours the truth resolves: by default a tumour's stiff tissue is the few tetrahedra whose
+centroid lies within 8 mm of its centre (5 to 12 cells of the 5000 mm^3 meshes), which the
+7.2 mm sphere the method tracks straddles; --tumour-max-volume V meshes those spheres as internal
+surfaces with tetrahedra of at most V mm^3 inside (about 500 per tumour at V = 40), so that the
+stiff tissue is the tracked tumour and its shape is resolved (BENCHMARKS.md, "Tumours the truth
+resolves").
+
 Usage: /usr/bin/python3 bench/make_independent_truth.py OUT [--fat-youngs-moduli 300 1000 3400]
-       [--max-volume 1500] [--order 2|3] [--refine 1] [--poisson-ratio 0.49] [--linear-solver auto|mumps|scipy]
+       [--max-volume 1500] [--tumour-max-volume 0] [--order 2|3] [--refine 1] [--poisson-ratio 0.49]
+       [--linear-solver auto|mumps|scipy]
        [--depth 60] [--half-width 85 70] [--half-height 65] [--sag 15] (lengths in mm, as
        bench/make_shape_model.py) [--gland-ratio 2] [--tumour-ratio 6]
        (needs Debian's python3-sfepy and tetgen; python3-petsc4py for MUMPS)"""
@@ -68,33 +76,67 @@ G = 9.81
 RHO = 1000.0
 
 
-def mesh_body(out, max_volume, a=60.0, bp=85.0, bm=70.0, c=65.0, s=15.0, refine=1):
+def mesh_body(out, max_volume, a=60.0, bp=85.0, bm=70.0, c=65.0, s=15.0, refine=1, tumour_surfaces=None,
+              tumour_max_volume=0.0):
+    """TetGen mesh of the body [mm]. With tumour_surfaces ({name: (V, F)} closed surfaces inside
+    the body) and tumour_max_volume > 0 the surfaces are meshed as internal boundaries (a
+    tetrahedron is inside one or not, none straddles) with that volume bound inside them; the
+    last return value then marks each tetrahedron inside a tumour (else None)."""
     # refine K: K times the rings and points per ring, the same landmarks (one ring of K stays).
     V, F, rings = surface(a, bp, bm, c, s, n_phi=40 * refine, n_theta=12 * refine, n_base=8 * refine)
-    off = os.path.join(out, 'body.off')
-    with open(off, 'w') as f:
-        f.write('OFF\n%d %d 0\n' % (len(V), len(F)))
-        f.writelines('%.9g %.9g %.9g\n' % tuple(v) for v in V)
-        f.writelines('3 %d %d %d\n' % tuple(t) for t in F)
-    subprocess.run(['tetgen', '-pq1.4a%g' % max_volume, '-zQ', off], check=True)
+    tumours = {'central': (0, -0.15 * c, 0.45 * a), 'lateral': (0.45 * bp, 0, 0.3 * a), 'upper': (0, 0.5 * c, 0.25 * a),
+               'lower': (0, -0.55 * c, 0.2 * a), 'medial': (-0.5 * bm, 0.05 * c, 0.25 * a)}
+    resolved = tumour_max_volume > 0
+    if resolved:
+        # A piecewise linear complex: the skin and every tumour surface as facets, each tumour a
+        # region (attribute 3) with its own volume bound (TetGen -A, and -a twice: regional, global).
+        smesh = os.path.join(out, 'body.smesh')
+        pts, facets = [np.asarray(V, float)], [np.asarray(F)]
+        offset = len(V)
+        for TV, TF in tumour_surfaces(tumours).values():
+            pts.append(np.asarray(TV, float))
+            facets.append(np.asarray(TF) + offset)
+            offset += len(TV)
+        P, T = np.concatenate(pts), np.concatenate(facets)
+        with open(smesh, 'w') as f:
+            f.write('%d 3 0 0\n' % len(P))
+            f.writelines('%d %.9g %.9g %.9g\n' % (i, *p) for i, p in enumerate(P))
+            f.write('%d 0\n' % len(T))
+            f.writelines('3 %d %d %d\n' % tuple(t) for t in T)
+            f.write('0\n%d\n' % len(tumours))
+            f.writelines('%d %.9g %.9g %.9g 3 %g\n' % (i, *p, tumour_max_volume) for i, p in enumerate(tumours.values()))
+        subprocess.run(['tetgen', '-pq1.4Aaa%g' % max_volume, '-zQ', smesh], check=True)
+    else:
+        off = os.path.join(out, 'body.off')
+        with open(off, 'w') as f:
+            f.write('OFF\n%d %d 0\n' % (len(V), len(F)))
+            f.writelines('%.9g %.9g %.9g\n' % tuple(v) for v in V)
+            f.writelines('3 %d %d %d\n' % tuple(t) for t in F)
+        subprocess.run(['tetgen', '-pq1.4a%g' % max_volume, '-zQ', off], check=True)
     node = np.loadtxt(os.path.join(out, 'body.1.node'), comments='#', skiprows=1)[:, 1:4]
-    ele = np.loadtxt(os.path.join(out, 'body.1.ele'), comments='#', skiprows=1, dtype=int)[:, 1:5]
+    ele_rows = np.loadtxt(os.path.join(out, 'body.1.ele'), comments='#', skiprows=1)
+    ele = ele_rows[:, 1:5].astype(int)
+    in_tumour = np.rint(ele_rows[:, 5]).astype(int) == 3 if resolved else None
     d = np.einsum('ij,ij->i', np.cross(node[ele[:, 1]] - node[ele[:, 0]], node[ele[:, 2]] - node[ele[:, 0]]),
                   node[ele[:, 3]] - node[ele[:, 0]])
     ele[d < 0] = ele[d < 0][:, [0, 2, 1, 3]]
     ring = rings[(len(rings) // refine * 5 // 9 + 1) * refine - 1]  # 52.5 deg from the apex
     n_phi = len(ring)
     landmarks = {'C': 0, 'O1': ring[0], 'O2': ring[n_phi // 4], 'O3': ring[n_phi // 2], 'O4': ring[3 * n_phi // 4]}
-    tumours = {'central': (0, -0.15 * c, 0.45 * a), 'lateral': (0.45 * bp, 0, 0.3 * a), 'upper': (0, 0.5 * c, 0.25 * a),
-               'lower': (0, -0.55 * c, 0.2 * a), 'medial': (-0.5 * bm, 0.05 * c, 0.25 * a)}
     gland = {'centre': np.array([0.0, -0.1 * c, 0.3 * a]), 'axes': np.array([0.55 * bp, 0.55 * c, 0.4 * a])}
-    return node, ele, landmarks, tumours, gland, (a, bp, bm, c, s)
+    return node, ele, landmarks, tumours, gland, (a, bp, bm, c, s), in_tumour
 
 
-def labels(node, ele, tumours, gland, radius):
+def labels(node, ele, tumours, gland, radius, in_tumour=None):
+    """1 fat, 2 gland (centroid in the ellipsoid), 3 tumour: the tetrahedra inside the tumour
+    surfaces where the mesh follows them (in_tumour), else those whose centroid lies within
+    `radius` of a tumour's centre."""
     cen = node[ele].mean(axis=1)
     lab = np.ones(len(ele), dtype=np.int32)  # 1 fat
     lab[(((cen - gland['centre']) / gland['axes']) ** 2).sum(axis=1) < 1] = 2  # 2 gland
+    if in_tumour is not None:
+        lab[in_tumour] = 3
+        return lab
     for p in tumours.values():
         lab[np.linalg.norm(cen - np.array(p), axis=1) < radius] = 3  # 3 tumour
     return lab
@@ -305,6 +347,10 @@ def main():
                     help='the displacement field: quadratic (P2) or cubic (P3) tetrahedra')
     ap.add_argument('--refine', type=int, default=1,
                     help='K times the skin surface\'s rings and points per ring (pass --max-volume / K^3 with it)')
+    ap.add_argument('--tumour-max-volume', type=float, default=0.0,
+                    help='mesh the tumour spheres as internal surfaces with this TetGen volume bound inside them [mm^3] '
+                         '(their stiff tissue is then exactly the tumour the method tracks); 0: tumour tissue is the '
+                         'tetrahedra whose centroid lies within 8 mm of a centre (the 7.2 mm tracked spheres straddle them)')
     ap.add_argument('--poisson-ratio', type=float, default=0.49)
     ap.add_argument('--gland-ratio', type=float, default=2.0)
     ap.add_argument('--tumour-ratio', type=float, default=6.0)
@@ -316,17 +362,19 @@ def main():
                     help='MUMPS (through petsc4py) when available, else SciPy')
     o = ap.parse_args()
     os.makedirs(o.out, exist_ok=True)
-    node, ele, landmarks, tumours, gland, dims = mesh_body(o.out, o.max_volume, o.depth, o.half_width[0], o.half_width[1],
-                                                       o.half_height, o.sag, o.refine)
     radius = 8.0
-    lab = labels(node, ele, tumours, gland, radius)
+    spheres = lambda centres: {n: icosphere(p, radius * 0.9) for n, p in centres.items()}
+    node, ele, landmarks, tumours, gland, dims, in_tumour = mesh_body(
+        o.out, o.max_volume, o.depth, o.half_width[0], o.half_width[1], o.half_height, o.sag, o.refine, spheres,
+        o.tumour_max_volume)
+    lab = labels(node, ele, tumours, gland, radius, in_tumour)
     bface = boundary(ele)
     used = np.unique(bface)
     renum = -np.ones(len(node), dtype=int)
     renum[used] = np.arange(len(used))
     sface = renum[bface]
     chest = np.nonzero(np.abs(node[used, 2]) < 1e-9)[0]
-    tum_surf = {n: icosphere(p, radius * 0.9) for n, p in tumours.items()}
+    tum_surf = spheres(tumours)
     gland_surf = icosphere((0.0, 0.0, 0.0), 1.0)
     gland_surf = (np.asarray(gland_surf[0]) * gland['axes'] + gland['centre'], gland_surf[1])
     gland_surf[0][:, 2] = np.maximum(gland_surf[0][:, 2], 0.5)  # the ellipsoid's part behind the chest wall is cut off
