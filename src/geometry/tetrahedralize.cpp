@@ -25,6 +25,24 @@ using Domain = CGAL::Polyhedral_mesh_domain_with_features_3<K, CgalSurface>;
 using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_tag>::type;
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
+
+/// The cells' size bound: the global size, finer in the refinement balls and graded around them
+/// (a model of CGAL's MeshDomainField_3).
+struct CellSizeField {
+  using FT = K::FT;
+  using Point_3 = K::Point_3;
+  using Index = Domain::Index;
+  double h;
+  const std::vector<MeshRefinement>* balls;
+  double grading;
+  FT operator()(const Point_3& p, const int, const Index&) const { return at(Vec3(p.x(), p.y(), p.z())); }
+  double at(const Vec3& x) const {
+    double s = h;
+    for (const MeshRefinement& b : *balls)
+      s = std::min(s, b.cell_size + grading * std::max(0.0, (x - b.centre).norm() - b.radius));
+    return s;
+  }
+};
 }  // namespace
 
 TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& opt) {
@@ -39,8 +57,25 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   // Memory budget, checked before meshing (issue 11: --cell-size 0.5 grew without limit).
   // CGAL makes about 4.3 V / c^3 tetrahedra at cell size c (34.7k for the 0.84 L phantom at
   // 4.7 mm); each costs about 1 kB through meshing, assembly and factorization.
+  for (const MeshRefinement& b : opt.refinements)
+    if (!(b.cell_size > 0) || !(b.cell_size <= opt.cell_size) || !(b.radius >= 0) || !b.centre.allFinite())
+      throw InputError("tetrahedralize: a refinement needs a finite centre, a radius >= 0 and a cell size in (0, cell_size]");
+  if (!opt.refinements.empty() && !(opt.refinement_grading > 0))
+    throw InputError("tetrahedralize: refinement_grading must be positive");
   const double volume = std::abs(enclosed_volume(surface));
-  const double estimate = 4.3 * volume / std::pow(opt.cell_size, 3);
+  double estimate = 4.3 * volume / std::pow(opt.cell_size, 3);
+  // Each ball and its graded shell, as if it lay inside the volume (an upper estimate): the
+  // size grows linearly from the ball's to the global one over (h - c) / grading.
+  for (const MeshRefinement& b : opt.refinements) {
+    const double shell = (opt.cell_size - b.cell_size) / opt.refinement_grading;
+    const int n = 64;
+    for (int k = 0; k < n; ++k) {  // midpoint rule over the radius
+      const double r = (b.radius + shell) * (k + 0.5) / n;
+      const double size = std::min(opt.cell_size, b.cell_size + opt.refinement_grading * std::max(0.0, r - b.radius));
+      const double dv = 4 * M_PI * r * r * (b.radius + shell) / n;
+      estimate += 4.3 * dv * (1 / std::pow(size, 3) - 1 / std::pow(opt.cell_size, 3));
+    }
+  }
   if (estimate > kMaxTetrahedra)
     throw InputError("tetrahedralize: a cell size of " + std::to_string(opt.cell_size * 1e3) + " mm would make about " +
                      std::to_string(static_cast<long>(estimate)) + " tetrahedra, more than the " +
@@ -59,9 +94,14 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   domain.detect_features(opt.feature_angle);
   const double h = opt.cell_size;
   namespace p = CGAL::parameters;
-  Criteria criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
-                    p::facet_distance = opt.facet_distance_ratio * h,
-                    p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = h);
+  const CellSizeField field{h, &opt.refinements, opt.refinement_grading};
+  Criteria criteria = opt.refinements.empty()
+                          ? Criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
+                                     p::facet_distance = opt.facet_distance_ratio * h,
+                                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = h)
+                          : Criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
+                                     p::facet_distance = opt.facet_distance_ratio * h,
+                                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = field);
   // The optimisers' time limits default to the measured refinement time, which made one input
   // give several meshes (issue 11). Without a time limit they stop when every dihedral angle
   // is above 10 deg (or nothing improves), and the domain's random generator is seeded

@@ -42,7 +42,7 @@ namespace {
 // Every key a scene may have; the informational ones (frame, rest, landmark_set,
 // landmark_vertices, generator, supine.tet_mesh_ground_truth) are written by btr_phantom.
 const std::vector<std::string> kSceneKeys = {
-    "units", "frame", "prone", "prone.tet_mesh", "prone.surface", "prone.cell_size_mm", "rest", "rest.tet_mesh",
+    "units", "frame", "prone", "prone.tet_mesh", "prone.surface", "prone.cell_size_mm", "prone.tumour_cell_size_mm", "rest", "rest.tet_mesh",
     "rest.surface", "chest_wall", "chest_ring", "landmarks", "landmarks.prone", "landmarks.supine", "patient_frame", "landmark_set", "landmark_vertices.*", "supine",
     "supine.surface", "supine.denoise", "supine.cloud", "supine.chest_ring", "supine.tet_mesh_ground_truth", "tumours", "tumours[]",
     "tumours[].name", "tumours[].prone", "tumours[].supine_ground_truth", "tumours[].rest", "material",
@@ -128,6 +128,11 @@ Scene load_scene_fields(const std::string& path) {
     }
   } else {
     c.fail("prone", "give prone.tet_mesh or prone.surface");
+  }
+  if (prone["tumour_cell_size_mm"]) {
+    s.tumour_cell_size = mm_to_m(c.number(prone["tumour_cell_size_mm"], "prone.tumour_cell_size_mm"));
+    if (!(s.tumour_cell_size >= 0) || !std::isfinite(s.tumour_cell_size))
+      c.fail("prone.tumour_cell_size_mm", "must be 0 (none) or a positive size");
   }
   if (prone["cell_labels"] && !prone["tet_mesh"]) c.fail("prone.cell_labels", "only with prone.tet_mesh (the file holding them)");
   if (prone["cell_size_mm"] && !have_surface) c.fail("prone.cell_size_mm", "only with prone.surface (the size it is tetrahedralized at)");

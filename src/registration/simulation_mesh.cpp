@@ -29,6 +29,7 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size) {
   Scene out = scene;
   TetrahedralizeOptions topt;
   topt.cell_size = cell_size;
+  topt.refinements = tumour_refinements(scene, cell_size);
   out.prone = tetrahedralize(surface, topt);
   out.chest_wall = boundary_vertices_near_region(out.prone, surface, wall, 1e-6 + topt.facet_distance_ratio * cell_size);
   Points landmarks(static_cast<Eigen::Index>(scene.landmark_anchors.size()), 3);
@@ -41,6 +42,20 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size) {
   return out;
 }
 
+std::vector<MeshRefinement> tumour_refinements(const Scene& s, double cell_size) {
+  std::vector<MeshRefinement> out;
+  if (!(s.tumour_cell_size > 0) || !(s.tumour_cell_size < cell_size)) return out;
+  for (const auto& t : s.tumours) {
+    if (t.prone.V.rows() == 0) continue;
+    MeshRefinement b;
+    b.centre = t.prone.V.colwise().mean().transpose();
+    b.radius = (t.prone.V.rowwise() - b.centre.transpose()).rowwise().norm().maxCoeff();
+    b.cell_size = s.tumour_cell_size;
+    out.push_back(b);
+  }
+  return out;
+}
+
 void mesh_prone(Scene& s, double cell_size) {
   if (!s.prone_source) throw InputError(s.path + ": the prone model is a tetrahedral mesh already");
   if (!(cell_size > 0) || !std::isfinite(cell_size))
@@ -48,6 +63,7 @@ void mesh_prone(Scene& s, double cell_size) {
   const ProneSurfaceSource& src = *s.prone_source;
   TetrahedralizeOptions topt;
   topt.cell_size = cell_size;
+  topt.refinements = tumour_refinements(s, cell_size);
   const auto t0 = std::chrono::steady_clock::now();
   try {
     s.prone = tetrahedralize(src.surface, topt);

@@ -12,6 +12,8 @@
 
 #include "breast_tumour_registration/base/errors.h"
 #include "breast_tumour_registration/fem/skinning_subspace.h"
+#include "breast_tumour_registration/geometry/embedding.h"
+#include "breast_tumour_registration/geometry/validation.h"
 #include "breast_tumour_registration/geometry/shapes.h"
 #include "breast_tumour_registration/geometry/surface_attachment.h"
 #include "breast_tumour_registration/geometry/surface_projector.h"
@@ -673,6 +675,38 @@ TEST(SceneErrors, KeysTypesUnitsAndGravityAreChecked) {
   };
   expect_throw_with<InputError>([&] { load_meshed_scene(without("units", "no_units")); }, "field 'units': missing");
   expect_throw_with<InputError>([&] { load_meshed_scene(without("gravity", "no_gravity")); }, "field 'gravity': missing");
+}
+
+// prone.tumour_cell_size_mm: where a call meshes the prone model (here re-meshes the phantom's
+// tetrahedra at 12 mm), each tumour's bounding ball gets finer cells; a bad value names the field.
+TEST(SceneFromSurface, TumourCellSizeRefinesTheSimulationMeshAroundEachTumour) {
+  const Scene plain = load_meshed_scene(phantom_dir() + "/scene.yaml");
+  const Scene stated = load_meshed_scene(scene_with("prone: {tet_mesh: prone.vtk, tumour_cell_size_mm: 5}", "tumour_cells"));
+  EXPECT_DOUBLE_EQ(stated.tumour_cell_size, 0.005);
+  EXPECT_EQ(plain.tumour_cell_size, 0);
+  expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("prone: {tet_mesh: prone.vtk, tumour_cell_size_mm: -2}", "bad_cells")); },
+                                "field 'prone.tumour_cell_size_mm': must be 0 (none) or a positive size");
+  const Scene a = with_simulation_mesh(plain, 0.012), b = with_simulation_mesh(stated, 0.012);
+  EXPECT_EQ(tumour_refinements(plain, 0.012).size(), 0u);
+  ASSERT_EQ(tumour_refinements(stated, 0.012).size(), stated.tumours.size());
+  EXPECT_EQ(tumour_refinements(stated, 0.004).size(), 0u);  // not below the mesh's own size: nothing to refine
+  // The mean volume of the tetrahedra holding the tumours' vertices.
+  auto tumour_cell_volume = [&](const Scene& m) {
+    double v = 0;
+    long n = 0;
+    for (const auto& t : m.tumours) {
+      const Embedding e = embed_points(m.prone, t.prone.V);
+      for (Eigen::Index i = 0; i < e.tet.size(); ++i, ++n) v += std::abs(tet_signed_volume(m.prone.V, m.prone.T, e.tet[i]));
+    }
+    return v / static_cast<double>(n);
+  };
+  std::printf("tumour cells: %.0f mm^3 at 12 mm, %.0f mm^3 with 5 mm around the tumours; %ld -> %ld tetrahedra\n",
+              tumour_cell_volume(a) * 1e9, tumour_cell_volume(b) * 1e9, static_cast<long>(a.prone.T.rows()),
+              static_cast<long>(b.prone.T.rows()));
+  EXPECT_LT(tumour_cell_volume(b), 0.25 * tumour_cell_volume(a));
+  EXPECT_GT(b.prone.T.rows(), a.prone.T.rows());
+  EXPECT_EQ(b.chest_wall.size() > 0, true);
+  EXPECT_EQ(b.landmark_anchors.size(), plain.landmark_anchors.size());
 }
 
 TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {

@@ -5,6 +5,8 @@
 #include "breast_tumour_registration/geometry/validation.h"
 #include "test_util.h"
 
+#include <cstdio>
+
 using namespace btr;
 
 namespace {
@@ -31,6 +33,43 @@ TEST(Tetrahedralize, SphereIsFilledWithPositiveWellShapedTetrahedra) {
   EXPECT_GT(q.min_dihedral_deg, 1.0);  // sliver exudation
   const TetMesh finer = tetrahedralize(s, TetrahedralizeOptions{0.006});
   EXPECT_GT(finer.T.rows(), 4 * m.T.rows());
+}
+
+// A stiff tumour on a 9 mm mesh holds a few tetrahedra and strains with the tissue around it;
+// a refinement ball gives it finer cells (tumour_refinements in simulation_mesh.h).
+TEST(Tetrahedralize, ARefinementBallHasFinerCellsInsideAndTheSkinKeepsItsSize) {
+  const SurfaceMesh s = make_icosphere(Vec3::Zero(), 0.05, 4);
+  TetrahedralizeOptions opt;
+  opt.cell_size = 0.012;
+  const TetMesh plain = tetrahedralize(s, opt);
+  MeshRefinement ball;
+  ball.centre = Vec3(0.01, 0.0, 0.0);
+  ball.radius = 0.008;
+  ball.cell_size = 0.004;
+  opt.refinements = {ball};
+  const TetMesh refined = tetrahedralize(s, opt);
+  EXPECT_NO_THROW(validate_tet_mesh(refined, "refined sphere"));
+  // Mean edge length of the tetrahedra whose centroid lies within `r` of the ball's centre.
+  auto mean_edge_near = [&](const TetMesh& m, double r) {
+    double sum = 0;
+    int n = 0;
+    for (Eigen::Index t = 0; t < m.T.rows(); ++t) {
+      Vec3 c = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) c += m.V.row(m.T(t, k)).transpose() / 4;
+      if ((c - ball.centre).norm() > r) continue;
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) sum += (m.V.row(m.T(t, a)) - m.V.row(m.T(t, b))).norm(), ++n;
+    }
+    return n ? sum / n : 0.0;
+  };
+  std::printf("mean edge in the ball: %.2f mm plain, %.2f mm refined; %ld -> %ld tetrahedra\n", 1e3 * mean_edge_near(plain, ball.radius),
+              1e3 * mean_edge_near(refined, ball.radius), static_cast<long>(plain.T.rows()), static_cast<long>(refined.T.rows()));
+  EXPECT_LT(mean_edge_near(refined, ball.radius), 0.6 * mean_edge_near(plain, ball.radius));
+  EXPECT_GT(refined.T.rows(), plain.T.rows());
+  EXPECT_LT(refined.T.rows(), 3 * plain.T.rows());  // graded back to 12 mm within (12 - 4) / 0.5 = 16 mm
+  // A ball finer than nothing, or coarser than the mesh, is refused.
+  opt.refinements[0].cell_size = 0.02;
+  btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); }, "a refinement needs");
 }
 
 TEST(Tetrahedralize, ACellSizeBeyondTheMemoryBudgetIsRefusedBeforeMeshing) {

@@ -4,9 +4,20 @@
 // them (landmarks, chest wall) are re-attached with surface_attachment.h.
 #pragma once
 
+#include <vector>
+
 #include "breast_tumour_registration/base/types.h"
 
 namespace btr {
+
+/// A ball where the mesh is finer (a tumour and the tissue around it): cells of at most
+/// `cell_size` inside, growing by TetrahedralizeOptions::refinement_grading per unit distance
+/// outside, up to the global cell size.
+struct MeshRefinement {
+  Vec3 centre = Vec3::Zero();  ///< [m]
+  double radius = 0;           ///< [m]
+  double cell_size = 0;        ///< [m], below TetrahedralizeOptions::cell_size
+};
 
 struct TetrahedralizeOptions {
   double cell_size = 0.008;          ///< target edge / circumradius bound [m]
@@ -15,6 +26,8 @@ struct TetrahedralizeOptions {
   double facet_angle = 25.0;         ///< minimum boundary triangle angle [deg]
   double feature_angle = 60.0;       ///< dihedral angle below which an edge is sharp [deg]
   bool optimize = true;              ///< perturb and exude slivers
+  std::vector<MeshRefinement> refinements;  ///< finer cells in these balls (the skin keeps cell_size)
+  double refinement_grading = 0.5;   ///< growth of the cell size per unit distance outside a ball
 };
 
 struct TetQuality {

@@ -5,6 +5,8 @@
 //   prone:
 //     tet_mesh: prone.vtk          # or `surface: prone.obj` to tetrahedralize (cell_size_mm)
 //     cell_size_mm: 6
+//     tumour_cell_size_mm: 4       # optional: where a call meshes the prone model, finer cells
+//                                  # around each tumour (0: none)
 //   chest_wall: chest_wall.txt     # vertex indices of prone.tet_mesh (or of prone.surface)
 //   chest_ring: chest_ring.obj     # optional: prone rigid skin around the breast (for ICP)
 //   landmarks: landmarks.csv       # optional: prone index with supine index or supine x,y,z
@@ -89,6 +91,10 @@ struct Scene {
   std::optional<SurfaceMesh> prone_rigid;     ///< model frame
   std::optional<SurfaceMesh> supine_rigid;    ///< supine frame
   std::vector<SceneTumour> tumours;
+  /// `prone.tumour_cell_size_mm` [m]: where the prone model is (re-)tetrahedralized for a call,
+  /// cells of at most this size in each tumour's bounding ball, graded to the call's size around
+  /// it (tumour_refinements in simulation_mesh.h); 0: none.
+  double tumour_cell_size = 0;
   MaterialParameters material;
   /// Whether the scene states `material.unload_element_order`; where it does not, a preset may
   /// choose the unload's elements (RegistrationOptions::unload_element_order)

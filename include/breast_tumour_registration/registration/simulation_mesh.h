@@ -5,6 +5,9 @@
 // deformation field (BENCHMARKS.md measures the trade).
 #pragma once
 
+#include <vector>
+
+#include "breast_tumour_registration/geometry/tetrahedralize.h"
 #include "breast_tumour_registration/io/scene.h"
 
 namespace btr {
@@ -19,8 +22,13 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size);
 
 /// Tetrahedralizes a scene's prone surface (s.prone_source) at cell_size [m] and attaches the
 /// chest wall and the landmarks to the tetrahedra. InputError naming the field on failure, or
-/// when the prone model is a tetrahedral mesh already.
+/// when the prone model is a tetrahedral mesh already. With s.tumour_cell_size below cell_size,
+/// finer cells in each tumour's bounding ball, graded to cell_size around it (tumour_refinements).
 void mesh_prone(Scene& s, double cell_size);
+
+/// One MeshRefinement per tumour of the scene (its prone surface's bounding ball about the
+/// vertex mean) with s.tumour_cell_size; none where that is 0 or not below cell_size.
+std::vector<MeshRefinement> tumour_refinements(const Scene& s, double cell_size);
 
 /// load_scene, then a prone surface meshed at its prone.cell_size_mm (else kDefaultCellSize):
 /// for callers that need the tetrahedra without an engine (which meshes at the size a call
