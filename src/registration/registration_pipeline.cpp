@@ -200,8 +200,9 @@ bool unloads_in_preparation(const Scene& s) { return s.prone_gravity && !s.young
 bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt) {
   if (opt.simulation_cell_size <= 0) return false;
   // CGAL's meshes at cell size c have a mean edge of about 1.35 c (1.34 measured on the
-  // phantom at 4.7 mm): remesh only a scene mesh clearly finer than that.
-  return mean_edge_length(scene.prone) < 1.1 * opt.simulation_cell_size;
+  // phantom at 4.7 mm): remesh only a scene mesh clearly finer than that, away from its
+  // tumours (a mesh made with prone.tumour_cell_size_mm is finer there by design).
+  return mean_edge_length_away_from_tumours(scene, opt.simulation_cell_size) < 1.1 * opt.simulation_cell_size;
 }
 
 std::optional<Scene> simulation_scene(const Scene& scene, const RegistrationOptions& opt) {

@@ -707,6 +707,12 @@ TEST(SceneFromSurface, TumourCellSizeRefinesTheSimulationMeshAroundEachTumour) {
   EXPECT_GT(b.prone.T.rows(), a.prone.T.rows());
   EXPECT_EQ(b.chest_wall.size() > 0, true);
   EXPECT_EQ(b.landmark_anchors.size(), plain.landmark_anchors.size());
+  // Finer around its tumours, not elsewhere: a call at 12 mm does not mesh it again.
+  RegistrationOptions at12 = preset_options("balanced");
+  at12.simulation_cell_size = 0.012;
+  EXPECT_LT(mean_edge_length(b.prone), 1.1 * 0.012);
+  EXPECT_FALSE(needs_simulation_mesh(b, at12));
+  EXPECT_FALSE(needs_simulation_mesh(a, at12));
 }
 
 TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {

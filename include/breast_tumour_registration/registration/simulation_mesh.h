@@ -30,6 +30,12 @@ void mesh_prone(Scene& s, double cell_size);
 /// vertex mean) with s.tumour_cell_size; none where that is 0 or not below cell_size.
 std::vector<MeshRefinement> tumour_refinements(const Scene& s, double cell_size);
 
+/// Mean edge length of the scene's prone mesh away from its tumours' refined balls and their
+/// graded shells at cell_size (tumour_refinements; the whole mesh where nothing lies outside
+/// them) [m]: the size it was meshed at, which a mesh refined around its tumours would
+/// otherwise understate (and be meshed again).
+double mean_edge_length_away_from_tumours(const Scene& s, double cell_size);
+
 /// load_scene, then a prone surface meshed at its prone.cell_size_mm (else kDefaultCellSize):
 /// for callers that need the tetrahedra without an engine (which meshes at the size a call
 /// simulates instead).
