@@ -93,9 +93,9 @@ struct Scene {
   std::vector<SceneTumour> tumours;
   /// `prone.tumour_cell_size_mm` [m]: where the prone model is (re-)tetrahedralized for a call,
   /// cells of at most this size in each tumour's bounding ball, graded to the call's size around
-  /// it (tumour_refinements in simulation_mesh.h); 0: none, the default (BENCHMARKS.md, "Tumours
-  /// the truth resolves": 4 mm cuts the stiff tumours' shape error 1.6 to 3.1 times on truth that resolves them,
-  /// at 1.25 to 2.1 times the balanced call; not the default yet).
+  /// it (tumour_refinements in simulation_mesh.h); 0: none, the default. BENCHMARKS.md, "Tumours
+  /// the truth resolves": 4 mm cuts the stiff tumours' shape error 1.6 to 3.1 times on truth that
+  /// resolves them, at 1.25 to 2.1 times the balanced call; not the default yet.
   double tumour_cell_size = 0;
   MaterialParameters material;
   /// Whether the scene states `material.unload_element_order`; where it does not, a preset may
