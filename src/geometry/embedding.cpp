@@ -140,8 +140,7 @@ bool inside_closed_surface(const SurfaceMesh& s, const Vec3& p) {
 std::vector<int> tetrahedra_inside(const TetMesh& mesh, const std::vector<const SurfaceMesh*>& surfaces) {
   std::vector<int> out;
   for (Eigen::Index e = 0; e < mesh.T.rows(); ++e) {
-    Vec3 c = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) c += mesh.V.row(mesh.T(e, k)).transpose() / 4.0;
+    const Vec3 c = tet_centroid(mesh.V, mesh.T, e);
     for (const SurfaceMesh* s : surfaces) {
       const Vec3 lo = s->V.colwise().minCoeff().transpose(), hi = s->V.colwise().maxCoeff().transpose();
       if ((c.array() < lo.array()).any() || (c.array() > hi.array()).any()) continue;

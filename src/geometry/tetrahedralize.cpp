@@ -26,24 +26,26 @@ using Tr = CGAL::Mesh_triangulation_3<Domain, CGAL::Default, CGAL::Sequential_ta
 using C3t3 = CGAL::Mesh_complex_3_in_triangulation_3<Tr, Domain::Corner_index, Domain::Curve_index>;
 using Criteria = CGAL::Mesh_criteria_3<Tr>;
 
-/// The cells' size bound: the global size, finer in the refinement balls and graded around them
-/// (a model of CGAL's MeshDomainField_3).
+// A refinement ball's size bound at `distance` from its centre (before the global cap).
+double graded_size(const MeshRefinement& b, double distance, double grading) {
+  return b.cell_size + grading * std::max(0.0, distance - b.radius);
+}
+
+/// cell_size_at as CGAL's MeshDomainField_3.
 struct CellSizeField {
   using FT = K::FT;
   using Point_3 = K::Point_3;
   using Index = Domain::Index;
-  double h;
-  const std::vector<MeshRefinement>* balls;
-  double grading;
-  FT operator()(const Point_3& p, const int, const Index&) const { return at(Vec3(p.x(), p.y(), p.z())); }
-  double at(const Vec3& x) const {
-    double s = h;
-    for (const MeshRefinement& b : *balls)
-      s = std::min(s, b.cell_size + grading * std::max(0.0, (x - b.centre).norm() - b.radius));
-    return s;
-  }
+  const TetrahedralizeOptions* opt;
+  FT operator()(const Point_3& p, const int, const Index&) const { return cell_size_at(Vec3(p.x(), p.y(), p.z()), *opt); }
 };
 }  // namespace
+
+double cell_size_at(const Vec3& x, const TetrahedralizeOptions& opt) {
+  double s = opt.cell_size;
+  for (const MeshRefinement& b : opt.refinements) s = std::min(s, graded_size(b, (x - b.centre).norm(), opt.refinement_grading));
+  return s;
+}
 
 TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& opt) {
   if (!(opt.cell_size > 0) || !std::isfinite(opt.cell_size))
@@ -71,7 +73,7 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
     const int n = 64;
     for (int k = 0; k < n; ++k) {  // midpoint rule over the radius
       const double r = (b.radius + shell) * (k + 0.5) / n;
-      const double size = std::min(opt.cell_size, b.cell_size + opt.refinement_grading * std::max(0.0, r - b.radius));
+      const double size = std::min(opt.cell_size, graded_size(b, r, opt.refinement_grading));
       const double dv = 4 * M_PI * r * r * (b.radius + shell) / n;
       estimate += 4.3 * dv * (1 / std::pow(size, 3) - 1 / std::pow(opt.cell_size, 3));
     }
@@ -94,14 +96,14 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   domain.detect_features(opt.feature_angle);
   const double h = opt.cell_size;
   namespace p = CGAL::parameters;
-  const CellSizeField field{h, &opt.refinements, opt.refinement_grading};
-  Criteria criteria = opt.refinements.empty()
-                          ? Criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
-                                     p::facet_distance = opt.facet_distance_ratio * h,
-                                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = h)
-                          : Criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
-                                     p::facet_distance = opt.facet_distance_ratio * h,
-                                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = field);
+  // A constant size where nothing is refined (the field would give the same bound, but CGAL's
+  // meshes are kept as they were, bit for bit).
+  auto criteria_with = [&](const auto& cell_size) {
+    return Criteria(p::edge_size = h, p::facet_angle = opt.facet_angle, p::facet_size = h,
+                    p::facet_distance = opt.facet_distance_ratio * h, p::cell_radius_edge_ratio = opt.radius_edge_ratio,
+                    p::cell_size = cell_size);
+  };
+  const Criteria criteria = opt.refinements.empty() ? criteria_with(h) : criteria_with(CellSizeField{&opt});
   // The optimisers' time limits default to the measured refinement time, which made one input
   // give several meshes (issue 11). Without a time limit they stop when every dihedral angle
   // is above 10 deg (or nothing improves), and the domain's random generator is seeded

@@ -80,12 +80,26 @@ bool orient_tets_positive(TetMesh& m) {
   return true;
 }
 
+Vec3 tet_centroid(const Points& V, const Tetrahedra& T, Eigen::Index t) {
+  Vec3 c = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) c += V.row(T(t, k)).transpose() / 4.0;
+  return c;
+}
+
 double mean_edge_length(const TetMesh& m) {
+  return mean_edge_length(m, [](Eigen::Index) { return true; });
+}
+
+double mean_edge_length(const TetMesh& m, const std::function<bool(Eigen::Index)>& keep) {
   double sum = 0;
-  for (Eigen::Index t = 0; t < m.T.rows(); ++t)
+  long kept = 0;
+  for (Eigen::Index t = 0; t < m.T.rows(); ++t) {
+    if (!keep(t)) continue;
+    ++kept;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) sum += (m.V.row(m.T(t, a)) - m.V.row(m.T(t, b))).norm();
-  return m.T.rows() ? sum / (6.0 * static_cast<double>(m.T.rows())) : 0.0;
+  }
+  return kept ? sum / (6.0 * static_cast<double>(kept)) : 0.0;
 }
 
 void validate_tet_mesh(const TetMesh& m, const std::string& name, double degenerate_rel) {

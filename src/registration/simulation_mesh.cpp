@@ -58,22 +58,12 @@ std::vector<MeshRefinement> tumour_refinements(const Scene& s, double cell_size)
 }
 
 double mean_edge_length_away_from_tumours(const Scene& s, double cell_size) {
-  const std::vector<MeshRefinement> balls = tumour_refinements(s, cell_size);
-  const double grading = TetrahedralizeOptions{}.refinement_grading;
-  double sum = 0;
-  long n = 0;
-  for (Eigen::Index t = 0; t < s.prone.T.rows(); ++t) {
-    Vec3 c = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) c += s.prone.V.row(s.prone.T(t, k)).transpose() / 4;
-    bool refined = false;
-    for (const MeshRefinement& b : balls)
-      refined = refined || (c - b.centre).norm() < b.radius + (cell_size - b.cell_size) / grading;
-    if (refined) continue;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b) sum += (s.prone.V.row(s.prone.T(t, a)) - s.prone.V.row(s.prone.T(t, b))).norm();
-    n += 6;
-  }
-  return n ? sum / static_cast<double>(n) : mean_edge_length(s.prone);
+  TetrahedralizeOptions topt;
+  topt.cell_size = cell_size;
+  topt.refinements = tumour_refinements(s, cell_size);
+  const double away = mean_edge_length(
+      s.prone, [&](Eigen::Index t) { return cell_size_at(tet_centroid(s.prone.V, s.prone.T, t), topt) >= cell_size; });
+  return away > 0 ? away : mean_edge_length(s.prone);
 }
 
 void mesh_prone(Scene& s, double cell_size) {

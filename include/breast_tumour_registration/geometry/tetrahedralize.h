@@ -26,9 +26,13 @@ struct TetrahedralizeOptions {
   double facet_angle = 25.0;         ///< minimum boundary triangle angle [deg]
   double feature_angle = 60.0;       ///< dihedral angle below which an edge is sharp [deg]
   bool optimize = true;              ///< perturb and exude slivers
-  std::vector<MeshRefinement> refinements;  ///< finer cells in these balls (the skin keeps cell_size)
+  std::vector<MeshRefinement> refinements{};  ///< finer cells in these balls (the skin keeps cell_size)
   double refinement_grading = 0.5;   ///< growth of the cell size per unit distance outside a ball
 };
+
+/// The cell-size bound at x [m]: opt.cell_size, finer in and around opt.refinements (each ball's
+/// size, growing by opt.refinement_grading per unit distance outside it).
+double cell_size_at(const Vec3& x, const TetrahedralizeOptions& opt);
 
 struct TetQuality {
   double max_radius_edge = 0;     ///< worst circumradius / shortest edge

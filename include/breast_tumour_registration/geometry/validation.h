@@ -1,6 +1,8 @@
 // Geometric validation of meshes with messages that say what is wrong and where.
 #pragma once
 
+#include <functional>
+
 #include <string>
 
 #include "breast_tumour_registration/base/types.h"
@@ -21,8 +23,13 @@ void validate_surface(const SurfaceMesh& mesh, const std::string& name, const Su
 /// Signed volume of tetrahedron t (positive for the library's orientation).
 double tet_signed_volume(const Points& V, const Tetrahedra& T, Eigen::Index t);
 
+/// Centroid of tetrahedron t [m].
+Vec3 tet_centroid(const Points& V, const Tetrahedra& T, Eigen::Index t);
+
 /// Mean length of the six edges of every tetrahedron (indices must be in range) [m].
 double mean_edge_length(const TetMesh& m);
+/// The same over the tetrahedra `keep` accepts (0 where it accepts none) [m].
+double mean_edge_length(const TetMesh& m, const std::function<bool(Eigen::Index)>& keep);
 
 /// Flips every tetrahedron when all are negatively oriented (a file convention);
 /// returns true when it did. Mixed orientations are left for validate_tet_mesh to reject.
