@@ -4,8 +4,8 @@
 # AR_500 never run before) the median axis-ratio error is lower on every scene and the median
 # worst tumour is not farther by > 0.02 mm on any; (2) on the straddled truths the median over
 # scenes of the after/before ratio of median worst tumour is <= 1.02 and none is farther by > 0.1 mm.
-cd /work/main
-F=/tmp/front; H=/tmp/heldout; T=test/data
+cd "$(dirname "$0")/../../.."  # the repository
+F=${FRONT:-/tmp/front}; H=${HELDOUT:-/tmp/heldout}; T=test/data  # where the bodies were made
 declare -A SC=(
  [BR_500]=$F/BR/E500 [BR_1000]=$F/BR/E1000 [BR_3400]=$F/BR/E3400
  [AR_500]=$F/AR/E500 [AR_1000]=$F/AR/E1000 [AR_3400]=$F/AR/E3400
@@ -17,7 +17,7 @@ for n in "${!SC[@]}"; do specs+=("$n=${SC[$n]}/scene_estimated_regions.yaml"); d
 specs+=("C700_told=$H/C/E700/scene_unloaded_regions.yaml")
 for f in 0.99 0.995 1.0 1.005 1.01; do
   c=$(python3 -c "print(round(7*$f,4))"); c8=$(python3 -c "print(round(8*$f,4))")
-  AFTER_SETTING=prone.tumour_cell_size_mm=4 EXTRA="--preset accurate --cell-size $c" bash bench/compare_builds.sh /tmp/acc_draws/d$f "${specs[@]}" > /tmp/acc_draws/d$f.md 2>&1
-  AFTER_SETTING=prone.tumour_cell_size_mm=4 EXTRA="--preset accurate --cell-size $c8" bash bench/compare_builds.sh /tmp/acc_draws/d$f P400=$F/ph400/scene_est.yaml > /tmp/acc_draws/d${f}_P400.md 2>&1
+  AFTER_SETTING=prone.tumour_cell_size_mm=4 EXTRA="--preset accurate --cell-size $c" bash bench/compare_builds.sh ${OUT:-/tmp/acc_draws}/d$f "${specs[@]}" > ${OUT:-/tmp/acc_draws}/d$f.md 2>&1
+  AFTER_SETTING=prone.tumour_cell_size_mm=4 EXTRA="--preset accurate --cell-size $c8" bash bench/compare_builds.sh ${OUT:-/tmp/acc_draws}/d$f P400=$F/ph400/scene_est.yaml > ${OUT:-/tmp/acc_draws}/d${f}_P400.md 2>&1
 done
-echo done > /tmp/acc_draws/DONE
+echo done > ${OUT:-/tmp/acc_draws}/DONE
