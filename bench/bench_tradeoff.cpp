@@ -80,12 +80,12 @@ int main(int argc, char** argv) {
     // re-tetrahedralized: another mesh than a user's call simulates); a tetrahedral prone model
     // is re-tetrahedralized at each size.
     const Scene scene = load_scene(scene_path);
-    const auto simulation_scene = [&scene](double cell_mm) {
+    const auto simulation_scene = [&scene](double cell_mm, double tumour_cells) {
       Scene s = scene;
       if (s.prone_source)
-        mesh_prone(s, cell_mm > 0 ? mm_to_m(cell_mm) : s.prone_source->cell_size.value_or(kDefaultCellSize));
+        mesh_prone(s, cell_mm > 0 ? mm_to_m(cell_mm) : s.prone_source->cell_size.value_or(kDefaultCellSize), tumour_cells);
       else if (cell_mm > 0)
-        s = with_simulation_mesh(s, mm_to_m(cell_mm));
+        s = with_simulation_mesh(s, mm_to_m(cell_mm), tumour_cells);
       return s;
     };
     std::vector<Point> points;
@@ -136,9 +136,10 @@ int main(int argc, char** argv) {
     if (!csv) throw InputError("cannot write '" + out_path + "'");
     csv << "knob,value,base_preset,cell_size_mm,tetrahedra,prepare_seconds,seconds_median,worst_error_mm,mean_error_mm,"
            "converged,volume_form,mesh_draws,worst_error_min_mm,worst_error_max_mm\n";
-    // One engine per simulation mesh (as the node keeps it): prepared once, solved repeatedly.
-    std::map<double, std::unique_ptr<RegistrationEngine>> engines;
-    std::map<double, double> prepare_seconds;
+    // One engine per simulation mesh (cell size, and the preset's tumour cells; as the node keeps
+    // it): prepared once, solved repeatedly.
+    std::map<std::pair<double, double>, std::unique_ptr<RegistrationEngine>> engines;
+    std::map<std::pair<double, double>, double> prepare_seconds;
     for (const Point& p : points) {
       // The point's cell sizes: its own, or mesh_draws sizes over +-mesh_jitter of it.
       std::vector<double> sizes{p.cell_mm};
@@ -151,17 +152,18 @@ int main(int argc, char** argv) {
       int converged = 0;
       std::string forms;
       for (double c : sizes) {
-        if (!engines.count(c)) {
+        const std::pair<double, double> mesh{c, tumour_cell_size_for(scene, p.opt)};
+        if (!engines.count(mesh)) {
           const auto t0 = std::chrono::steady_clock::now();
-          Scene s = simulation_scene(c);
+          Scene s = simulation_scene(mesh.first, mesh.second);
           std::vector<std::string> warnings;
           RegistrationModel m = prepare_model(s, warnings);
-          prepare_seconds[c] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          engines.emplace(c, std::make_unique<RegistrationEngine>(std::move(s), std::move(m), std::move(warnings)));
+          prepare_seconds[mesh] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          engines.emplace(mesh, std::make_unique<RegistrationEngine>(std::move(s), std::move(m), std::move(warnings)));
         }
-        RegistrationEngine& engine = *engines.at(c);
+        RegistrationEngine& engine = *engines.at(mesh);
         tets.push_back(static_cast<double>(engine.prepare(p.opt).model.rest.T.rows()));
-        prepares.push_back(prepare_seconds[c]);
+        prepares.push_back(prepare_seconds[mesh]);
         std::vector<double> draw_secs;
         RegistrationResult r;
         for (int i = 0; i < repeats; ++i) {

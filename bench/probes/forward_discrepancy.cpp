@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
       scene.gravity = model.prone_gravity;
       for (auto& t : scene.tumours) t.supine_ground_truth = conf.tumour_prone.at(t.name);
     }
-    if (h > 0) scene = with_simulation_mesh(scene, h * 1e-3);
+    if (h > 0) scene = with_simulation_mesh(scene, h * 1e-3, 0);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::string> warnings;
     RegistrationModel rm = prepare_model(scene, warnings);  // as the suite: this mesh, whatever the preset's

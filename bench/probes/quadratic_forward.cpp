@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
     run.steps = {"gravity"};
     std::vector<std::string> warnings;
     run.rest_shape = "rest";
-    auto meshed = [&](const Scene& s) { return h > 0 ? with_simulation_mesh(s, h) : s; };  // 0: the model's own mesh
+    auto meshed = [&](const Scene& s) { return h > 0 ? with_simulation_mesh(s, h, 0) : s; };  // 0: the model's own mesh
     const RegistrationModel rm = prepare_model(meshed(experiment_scene(model, conf, run, "balanced", "rest")), warnings);
     run.rest_shape = "prone";
     const RegistrationModel pm = prepare_model(meshed(experiment_scene(model, conf, run, "balanced", "prone")), warnings);

@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
   for (const auto& r : plan_experiments(o)) if (r.experiment == "practical" && r.setting == "full") run = r;
   Scene scene = experiment_scene(model, conf, run, "balanced", "estimated");
   scene.material.volume_form = std::string(argv[4]) == "nodal" ? VolumeForm::Nodal : VolumeForm::Element;
-  scene = with_simulation_mesh(scene, 0.007);
+  scene = with_simulation_mesh(scene, 0.007, 0);
   std::vector<std::string> w;
   RegistrationModel rm = prepare_model(scene, w);
   const double E0 = rm.material.youngs_modulus;

@@ -78,11 +78,21 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
       estimate += 4.3 * dv * (1 / std::pow(size, 3) - 1 / std::pow(opt.cell_size, 3));
     }
   }
-  if (estimate > kMaxTetrahedra)
+  if (estimate > kMaxTetrahedra) {
+    const std::string budget = " tetrahedra, more than the " + std::to_string(static_cast<long>(kMaxTetrahedra)) +
+                               " this package budgets (about 3 GB); ";
+    if (4.3 * volume / std::pow(opt.cell_size, 3) <= kMaxTetrahedra) {  // the refinement balls make it
+      double finest = opt.cell_size;
+      for (const MeshRefinement& b : opt.refinements) finest = std::min(finest, b.cell_size);
+      throw InputError("tetrahedralize: refinement balls with cells of " + std::to_string(finest * 1e3) + " mm (" +
+                       std::to_string(opt.refinements.size()) + (opt.refinements.size() == 1 ? " ball" : " balls") + ", graded to " + std::to_string(opt.cell_size * 1e3) +
+                       " mm) would make about " + std::to_string(static_cast<long>(estimate)) + budget +
+                       "use larger cells in the balls");
+    }
     throw InputError("tetrahedralize: a cell size of " + std::to_string(opt.cell_size * 1e3) + " mm would make about " +
-                     std::to_string(static_cast<long>(estimate)) + " tetrahedra, more than the " +
-                     std::to_string(static_cast<long>(kMaxTetrahedra)) + " this package budgets (about 3 GB); use at least " +
+                     std::to_string(static_cast<long>(estimate)) + budget + "use at least " +
                      std::to_string(std::cbrt(4.3 * volume / kMaxTetrahedra) * 1e3) + " mm");
+  }
 
   CgalSurface sm;
   std::vector<CgalSurface::Vertex_index> vi(surface.V.rows());

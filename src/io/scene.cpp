@@ -130,9 +130,9 @@ Scene load_scene_fields(const std::string& path) {
     c.fail("prone", "give prone.tet_mesh or prone.surface");
   }
   if (prone["tumour_cell_size_mm"]) {
-    s.tumour_cell_size = mm_to_m(c.number(prone["tumour_cell_size_mm"], "prone.tumour_cell_size_mm"));
-    if (!(s.tumour_cell_size >= 0) || !std::isfinite(s.tumour_cell_size))
-      c.fail("prone.tumour_cell_size_mm", "must be 0 (none) or a positive size");
+    const double cell = mm_to_m(c.number(prone["tumour_cell_size_mm"], "prone.tumour_cell_size_mm"));
+    if (!(cell >= 0) || !std::isfinite(cell)) c.fail("prone.tumour_cell_size_mm", "must be 0 (none) or a positive size");
+    s.tumour_cell_size = cell;
   }
   if (prone["cell_labels"] && !prone["tet_mesh"]) c.fail("prone.cell_labels", "only with prone.tet_mesh (the file holding them)");
   if (prone["cell_size_mm"] && !have_surface) c.fail("prone.cell_size_mm", "only with prone.surface (the size it is tetrahedralized at)");

@@ -84,7 +84,7 @@ RegistrationEngine::RegistrationEngine(Scene simulated, RegistrationModel model,
   e->prepared.scene = std::move(simulated);
   e->prepared.model = std::move(model);
   e->prepared.warnings = std::move(warnings);
-  entries_.emplace(std::make_pair(0.0, scene_.material.unload_element_order), std::move(e));
+  entries_.emplace(std::make_tuple(0.0, 0.0, scene_.material.unload_element_order), std::move(e));
 }
 
 RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& opt) {
@@ -98,9 +98,9 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
   RegistrationOptions mesh_opt = opt;  // with the mesh the preset simulates its nodal form on
   mesh_opt.simulation_cell_size = simulation_cell_size_for(scene_, opt);
   // The key is the mesh the call simulates (the size a prone surface is meshed at, the preset's
-  // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given) and the
-  // elements it is unloaded with. The first call on a mesh prepares it with its form; the other
-  // form is the entry's twin.
+  // size when the scene's mesh is re-tetrahedralized, or 0 for the scene's mesh as given; the
+  // finer cells around the tumours it is meshed with) and the elements it is unloaded with. The
+  // first call on a mesh prepares it with its form; the other form is the entry's twin.
   const ElementOrder unload_elements = preset_unload_elements(scene_, opt);
   const bool unmeshed = scene_.prone.T.rows() == 0 && scene_.prone_source;
   double key = 0;
@@ -109,16 +109,18 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
                                                                                    : kDefaultCellSize);
   else if (needs_simulation_mesh(scene_, mesh_opt))
     key = mesh_opt.simulation_cell_size;
-  auto it = entries_.find({key, unload_elements});
+  const double tumour_cells = tumour_cell_size_for(scene_, opt);  // 0 in the key where it refines nothing
+  const double tumour_key = key > 0 && !tumour_refinements(scene_, key, tumour_cells).empty() ? tumour_cells : 0;
+  auto it = entries_.find({key, tumour_key, unload_elements});
   if (it != entries_.end()) return twin_entry(*it->second, form);
 
   const auto t0 = std::chrono::steady_clock::now();
   auto e = std::make_unique<Entry>();
   PreparedScene& p = e->prepared;
   if (key > 0) {  // with_simulation_mesh meshes an unmeshed prone surface, else re-meshes the model
-    p.scene = with_simulation_mesh(scene_, key);
+    p.scene = with_simulation_mesh(scene_, key, tumour_key);
     p.mesh_note = (unmeshed ? "tetrahedralized the prone surface at " : "re-tetrahedralized the prone model at ") +
-                  format_mm(key);
+                  format_mm(key) + (tumour_key > 0 ? ", " + format_mm(tumour_key) + " in the tumours' balls" : "");
   } else {
     p.scene = scene_;
   }
@@ -127,7 +129,7 @@ RegistrationEngine::Entry& RegistrationEngine::entry(const RegistrationOptions& 
   p.mesh_seconds = key > 0 ? p.scene.tetrahedralize_seconds : 0;
   p.model = prepare_model(p.scene, p.warnings, unload_, &e->solvers);
   p.prepare_seconds = since(t0);
-  return *entries_.emplace(std::make_pair(key, unload_elements), std::move(e)).first->second;
+  return *entries_.emplace(std::make_tuple(key, tumour_key, unload_elements), std::move(e)).first->second;
 }
 
 const PreparedScene& RegistrationEngine::prepare(const RegistrationOptions& opt) { return entry(opt).prepared; }

@@ -307,7 +307,8 @@ void run_experiments(const PhantomModel& model, const ExperimentSuiteOptions& op
           scene.material.nodal_element_share = opt.method_nodal_element_share;
           scene.material.unload_element_order = opt.method_unload_element_order;
           scene.nodal_fallback = opt.method_nodal_fallback;
-          if (opt.simulation_cell_size > 0) scene = with_simulation_mesh(scene, opt.simulation_cell_size);
+          if (opt.simulation_cell_size > 0)  // as btr_register meshes it, the preset's tumour cells included
+            scene = with_simulation_mesh(scene, opt.simulation_cell_size, tumour_cell_size_for(scene, preset));
           std::vector<std::string> warnings;
           // The unloaded shape depends on the configuration and the method's material only:
           // estimated once per both, then reused (its time still counts in every run's seconds).

@@ -150,7 +150,7 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   EXPECT_EQ(r.volume_form, VolumeForm::Nodal);
   const PreparedScene& pn = engine.prepare(nodal);
   EXPECT_NE(pn.mesh_note.find("re-tetrahedralized"), std::string::npos) << pn.mesh_note;
-  Scene stated = with_simulation_mesh(s, 0.025);
+  Scene stated = with_simulation_mesh(s, 0.025, 0);
   stated.material.volume_form = VolumeForm::Nodal;
   stated.material.unload_element_order = nodal.unload_element_order;  // the preset's with its nodal form
   EXPECT_EQ(largest_difference(r.x, fresh(stated, nodal).x), 0.0);  // as if the scene had said nodal, on that mesh
@@ -179,6 +179,33 @@ TEST(Engine, APresetsNodalFormIsTakenWhereTheSceneUnloadsAndLeavesTheFormToAuto)
   prone_rest.prone_gravity.reset();
   EXPECT_FALSE(takes_preset_volume_form(prone_rest, balanced));
   EXPECT_EQ(RegistrationEngine(prone_rest).prepare(balanced).model.volume_form, VolumeForm::Element);
+}
+
+// A preset's tumour cells (RegistrationOptions::tumour_cell_size; accurate's 4 mm) apply where a
+// call meshes the prone model and the scene states none; the engine keeps the mesh made with
+// them apart from the one made without, and a scene's stated 0 means none.
+TEST(Engine, APresetsTumourCellsRefineTheMeshItMakesUnlessTheSceneStatesItsOwn) {
+  const Scene s = btr::test::coarse_phantom_scene();  // 12 mm, keeps the prone shape as rest
+  ASSERT_FALSE(s.tumour_cell_size.has_value());
+  RegistrationOptions coarse = preset_options("balanced");
+  coarse.simulation_cell_size = 0.025;  // coarser than the scene's mesh: re-tetrahedralized
+  RegistrationOptions cells = coarse;
+  cells.tumour_cell_size = 0.008;
+  RegistrationEngine engine(s);
+  const PreparedScene& plain = engine.prepare(coarse);
+  const PreparedScene& refined = engine.prepare(cells);
+  EXPECT_NE(&plain, &refined);
+  EXPECT_EQ(plain.mesh_note.find("tumours"), std::string::npos) << plain.mesh_note;
+  EXPECT_NE(refined.mesh_note.find("8.0 mm in the tumours' balls"), std::string::npos) << refined.mesh_note;
+  EXPECT_GT(refined.model.rest.T.rows(), plain.model.rest.T.rows());
+  EXPECT_EQ(refined.model.rest.T.rows(), with_simulation_mesh(s, 0.025, 0.008).prone.T.rows());
+  EXPECT_EQ(&engine.prepare(cells), &refined);  // kept
+  Scene none = s;  // prone.tumour_cell_size_mm: 0
+  none.tumour_cell_size = 0.0;
+  EXPECT_EQ(RegistrationEngine(none).prepare(cells).model.rest.T.rows(), plain.model.rest.T.rows());
+  RegistrationOptions at_scene_mesh = cells;  // the scene's mesh as given: nothing is meshed, nothing refined
+  at_scene_mesh.simulation_cell_size = 0;
+  EXPECT_EQ(RegistrationEngine(s).prepare(at_scene_mesh).model.rest.T.rows(), s.prone.T.rows());
 }
 
 // With their nodal form the balanced and accurate presets unload with quadratic elements, where

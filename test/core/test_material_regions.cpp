@@ -107,7 +107,7 @@ TEST(MaterialRegions, ASurfaceRegionSelectsTheLabelledTetrahedra) {
 
 TEST(MaterialRegions, TheSimulationMeshCarriesTheLabels) {
   const Scene s = load_meshed_scene(labelled_phantom_dir() + "/scene.yaml");
-  const Scene coarse = with_simulation_mesh(s, 0.016);
+  const Scene coarse = with_simulation_mesh(s, 0.016, 0);
   ASSERT_EQ(static_cast<Eigen::Index>(coarse.prone_labels.size()), coarse.prone.T.rows());
   auto gland_fraction = [](const TetMesh& m, const std::vector<int>& labels) {
     double g = 0, all = 0;

@@ -682,14 +682,22 @@ TEST(SceneErrors, KeysTypesUnitsAndGravityAreChecked) {
 TEST(SceneFromSurface, TumourCellSizeRefinesTheSimulationMeshAroundEachTumour) {
   const Scene plain = load_meshed_scene(phantom_dir() + "/scene.yaml");
   const Scene stated = load_meshed_scene(scene_with("prone: {tet_mesh: prone.vtk, tumour_cell_size_mm: 5}", "tumour_cells"));
-  EXPECT_DOUBLE_EQ(stated.tumour_cell_size, 0.005);
-  EXPECT_EQ(plain.tumour_cell_size, 0);
+  EXPECT_DOUBLE_EQ(stated.tumour_cell_size.value_or(-1), 0.005);
+  EXPECT_FALSE(plain.tumour_cell_size.has_value());  // the preset's (accurate: 4 mm; the others none)
+  const Scene none = load_meshed_scene(scene_with("prone: {tet_mesh: prone.vtk, tumour_cell_size_mm: 0}", "no_tumour_cells"));
+  EXPECT_EQ(none.tumour_cell_size.value_or(-1), 0.0);
+  const RegistrationOptions accurate = preset_options("accurate");
+  EXPECT_EQ(tumour_cell_size_for(plain, accurate), 0.004);
+  EXPECT_EQ(tumour_cell_size_for(plain, preset_options("balanced")), 0.0);
+  EXPECT_EQ(tumour_cell_size_for(plain, preset_options("fast")), 0.0);
+  EXPECT_EQ(tumour_cell_size_for(stated, accurate), 0.005);  // the scene's, stated, wins
+  EXPECT_EQ(tumour_cell_size_for(none, accurate), 0.0);
   expect_throw_with<InputError>([&] { load_meshed_scene(scene_with("prone: {tet_mesh: prone.vtk, tumour_cell_size_mm: -2}", "bad_cells")); },
                                 "field 'prone.tumour_cell_size_mm': must be 0 (none) or a positive size");
-  const Scene a = with_simulation_mesh(plain, 0.012), b = with_simulation_mesh(stated, 0.012);
-  EXPECT_EQ(tumour_refinements(plain, 0.012).size(), 0u);
-  ASSERT_EQ(tumour_refinements(stated, 0.012).size(), stated.tumours.size());
-  EXPECT_EQ(tumour_refinements(stated, 0.004).size(), 0u);  // not below the mesh's own size: nothing to refine
+  const Scene a = with_simulation_mesh(plain, 0.012, 0), b = with_simulation_mesh(stated, 0.012, 0.005);
+  EXPECT_EQ(tumour_refinements(plain, 0.012, 0).size(), 0u);
+  ASSERT_EQ(tumour_refinements(stated, 0.012, 0.005).size(), stated.tumours.size());
+  EXPECT_EQ(tumour_refinements(stated, 0.004, 0.005).size(), 0u);  // not below the mesh's own size: nothing to refine
   // The mean volume of the tetrahedra holding the tumours' vertices.
   auto tumour_cell_volume = [&](const Scene& m) {
     double v = 0;
@@ -713,6 +721,9 @@ TEST(SceneFromSurface, TumourCellSizeRefinesTheSimulationMeshAroundEachTumour) {
   EXPECT_LT(mean_edge_length(b.prone), 1.1 * 0.012);
   EXPECT_FALSE(needs_simulation_mesh(b, at12));
   EXPECT_FALSE(needs_simulation_mesh(a, at12));
+  // Cells too fine for the memory budget: refused before meshing, naming where the size came from.
+  expect_throw_with<InputError>([&] { with_simulation_mesh(plain, 0.012, 1e-5); },
+                                "refinement balls are the tumours', at 0.01 mm: prone.tumour_cell_size_mm, else the preset's");
 }
 
 TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
@@ -770,7 +781,7 @@ TEST(SceneFromSurface, TetrahedralizesAndReattachesChestWallAndLandmarks) {
       "nine_mm"));
   ASSERT_TRUE(nine.prone_source.has_value());
   EXPECT_EQ(nine.prone_source->cell_size.value_or(0), preset_options("balanced").nodal_simulation_cell_size);
-  mesh_prone(l, 0.012);
+  mesh_prone(l, 0.012, 0);
   EXPECT_TRUE(l.tetrahedralized);
   EXPECT_NEAR(static_cast<double>(l.prone.T.rows()), static_cast<double>(s.prone.T.rows()), 0.02 * s.prone.T.rows());
   EXPECT_EQ(l.landmark_anchors.size(), s.landmark_anchors.size());
@@ -944,7 +955,7 @@ TEST(SimulationMesh, ACoarserMeshKeepsChestWallLandmarksAndAccuracy) {
     EXPECT_LT(t.centroid_distance, 1.0e-3) << t.name;
     EXPECT_LT(t.centroid_distance, 0.5 * t.rigid_centroid_distance) << t.name;
   }
-  expect_throw_with<InputError>([&] { with_simulation_mesh(scene, -1); }, "must be positive");
+  expect_throw_with<InputError>([&] { with_simulation_mesh(scene, -1, 0); }, "must be positive");
 }
 
 namespace {

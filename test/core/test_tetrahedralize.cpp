@@ -77,6 +77,11 @@ TEST(Tetrahedralize, ACellSizeBeyondTheMemoryBudgetIsRefusedBeforeMeshing) {
   TetrahedralizeOptions opt;
   opt.cell_size = 0.0005;
   btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); }, "this package budgets");
+  // Where the refinement balls make it, the error says so, not "use a larger cell size".
+  opt.cell_size = 0.01;
+  opt.refinements = {MeshRefinement{Vec3::Zero(), 0.01, 1e-5}};
+  btr::test::expect_throw_with<InputError>([&] { tetrahedralize(s, opt); },
+                                           "refinement balls with cells of 0.010000 mm (1 ball, graded to 10.000000 mm)");
 }
 
 TEST(Tetrahedralize, BadOptionsAreRejected) {

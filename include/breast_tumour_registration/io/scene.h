@@ -6,7 +6,7 @@
 //     tet_mesh: prone.vtk          # or `surface: prone.obj` to tetrahedralize (cell_size_mm)
 //     cell_size_mm: 6
 //     tumour_cell_size_mm: 4       # optional: where a call meshes the prone model, finer cells
-//                                  # around each tumour (default 0: none)
+//                                  # around each tumour (0: none; default: the preset's)
 //   chest_wall: chest_wall.txt     # vertex indices of prone.tet_mesh (or of prone.surface)
 //   chest_ring: chest_ring.obj     # optional: prone rigid skin around the breast (for ICP)
 //   landmarks: landmarks.csv       # optional: prone index with supine index or supine x,y,z
@@ -93,10 +93,11 @@ struct Scene {
   std::vector<SceneTumour> tumours;
   /// `prone.tumour_cell_size_mm` [m]: where the prone model is (re-)tetrahedralized for a call,
   /// cells of at most this size in each tumour's bounding ball, graded to the call's size around
-  /// it (tumour_refinements in simulation_mesh.h); 0: none, the default. BENCHMARKS.md, "Tumours
-  /// the truth resolves": 4 mm cuts the stiff tumours' shape error 1.6 to 3.1 times on truth that
-  /// resolves them, at 1.25 to 2.1 times the balanced call; not the default yet.
-  double tumour_cell_size = 0;
+  /// it (tumour_refinements in simulation_mesh.h); 0: none. Not stated: the preset's
+  /// (RegistrationOptions::tumour_cell_size; the accurate preset 4 mm, the others none).
+  /// BENCHMARKS.md, "Tumours the truth resolves" and "Finer cells around the tumours in the
+  /// accurate preset".
+  std::optional<double> tumour_cell_size;
   MaterialParameters material;
   /// Whether the scene states `material.unload_element_order`; where it does not, a preset may
   /// choose the unload's elements (RegistrationOptions::unload_element_order)

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "breast_tumour_registration/io/scene.h"
@@ -148,8 +149,10 @@ class RegistrationEngine {
   Scene scene_;
   UnloadOptions unload_;
   bool adopted_ = false;                           ///< one entry for every call
-  /// By simulation cell size [m] and the unload's elements (preset_unload_elements)
-  std::map<std::pair<double, ElementOrder>, std::unique_ptr<Entry>> entries_;
+  /// By simulation cell size [m] (0: the scene's mesh as given), the tumour cell size it was
+  /// meshed with [m] (0: none; tumour_cell_size_for) and the unload's elements
+  /// (preset_unload_elements)
+  std::map<std::tuple<double, double, ElementOrder>, std::unique_ptr<Entry>> entries_;
 };
 
 }  // namespace btr

@@ -46,6 +46,13 @@ struct RegistrationOptions {
   /// > 0: the simulation cell size [m] where the preset's nodal form is taken (the nodal form is
   /// the costlier per tetrahedron and locks less, so its point on the front is a coarser mesh)
   double nodal_simulation_cell_size = 0;
+  /// > 0: where a call meshes the prone model, cells of at most this size [m] in each tumour's
+  /// bounding ball, graded to the call's size (tumour_refinements), unless the scene states
+  /// prone.tumour_cell_size_mm (tumour_cell_size_for). Accurate: 4 mm (2026-12-07, seventh
+  /// session, over five mesh draws: the stiff tumours' axis ratio nearer the truth on all six
+  /// resolved truths, the worst tumour nearer on five; BENCHMARKS.md, "Finer cells around the
+  /// tumours in the accurate preset"); fast and balanced: none.
+  double tumour_cell_size = 0;
   /// A rigid alignment found elsewhere (e.g. the ROS node's ICP tracking of the depth
   /// camera): supine -> model. When set, the rigid step uses it instead of Kabsch and ICP.
   std::optional<Rigid> known_supine_to_model;
@@ -82,6 +89,10 @@ bool takes_preset_volume_form(const Scene& scene, const RegistrationOptions& opt
 /// opt.simulation_cell_size (0: the scene's mesh as given). A mesh made at this size is simulated
 /// as it is (RegistrationEngine, btr_scene_from_labels).
 double simulation_cell_size_for(const Scene& scene, const RegistrationOptions& opt);
+
+/// The tumour cell size [m] a call meshes the prone model with: the scene's
+/// prone.tumour_cell_size_mm where stated (0: none), else opt.tumour_cell_size.
+double tumour_cell_size_for(const Scene& scene, const RegistrationOptions& opt);
 
 /// The elements `scene` is unloaded with in a registration with `opt`: the preset's
 /// (RegistrationOptions::unload_element_order) where it takes its nodal form and the scene does
