@@ -65,7 +65,8 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   if (!opt.refinements.empty() && !(opt.refinement_grading > 0))
     throw InputError("tetrahedralize: refinement_grading must be positive");
   const double volume = std::abs(enclosed_volume(surface));
-  double estimate = 4.3 * volume / std::pow(opt.cell_size, 3);
+  const double uniform = 4.3 * volume / std::pow(opt.cell_size, 3);  // without the balls
+  double estimate = uniform;
   // Each ball and its graded shell, as if it lay inside the volume (an upper estimate): the
   // size grows linearly from the ball's to the global one over (h - c) / grading.
   for (const MeshRefinement& b : opt.refinements) {
@@ -81,13 +82,14 @@ TetMesh tetrahedralize(const SurfaceMesh& surface, const TetrahedralizeOptions& 
   if (estimate > kMaxTetrahedra) {
     const std::string budget = " tetrahedra, more than the " + std::to_string(static_cast<long>(kMaxTetrahedra)) +
                                " this package budgets (about 3 GB); ";
-    if (4.3 * volume / std::pow(opt.cell_size, 3) <= kMaxTetrahedra) {  // the refinement balls make it
+    if (uniform <= kMaxTetrahedra) {  // the refinement balls make it
       double finest = opt.cell_size;
       for (const MeshRefinement& b : opt.refinements) finest = std::min(finest, b.cell_size);
+      const size_t n = opt.refinements.size();
       throw InputError("tetrahedralize: refinement balls with cells of " + std::to_string(finest * 1e3) + " mm (" +
-                       std::to_string(opt.refinements.size()) + (opt.refinements.size() == 1 ? " ball" : " balls") + ", graded to " + std::to_string(opt.cell_size * 1e3) +
-                       " mm) would make about " + std::to_string(static_cast<long>(estimate)) + budget +
-                       "use larger cells in the balls");
+                       std::to_string(n) + (n == 1 ? " ball" : " balls") + ", graded to " +
+                       std::to_string(opt.cell_size * 1e3) + " mm) would make about " +
+                       std::to_string(static_cast<long>(estimate)) + budget + "use larger cells in the balls");
     }
     throw InputError("tetrahedralize: a cell size of " + std::to_string(opt.cell_size * 1e3) + " mm would make about " +
                      std::to_string(static_cast<long>(estimate)) + budget + "use at least " +
