@@ -3,16 +3,18 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Image_3.h>
 #include <CGAL/Labeled_mesh_domain_3.h>
+#include <CGAL/Mesh_3/initialize_triangulation_from_labeled_image.h>
 #include <CGAL/Mesh_3/polylines_to_protect.h>
 #include <CGAL/Mesh_complex_3_in_triangulation_3.h>
 #include <CGAL/Mesh_criteria_3.h>
 #include <CGAL/Mesh_domain_with_polyline_features_3.h>
 #include <CGAL/Mesh_triangulation_3.h>
-#include <CGAL/make_mesh_3.h>
+#include <CGAL/refine_mesh_3.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <sstream>
 #include <unordered_map>
@@ -92,6 +94,29 @@ CGAL::Image_3 component_image(const LabelVolume& v, const std::vector<long>& vox
     data[(static_cast<long>(q[2]) * n[1] + q[1]) * n[0] + q[0]] = 1;
   }
   return CGAL::Image_3(im);
+}
+
+// The first surface points of a labelled image's mesh, from rays shot inside each connected
+// component of each label (CGAL's initialisation for labelled images). make_mesh_3's own shoots
+// rays from the centre of the image's box only, and finds none where that centre lies outside
+// the meshed labels (air or muscle between or behind the breasts, a crescent-shaped tumour):
+// it never returns.
+template <class C3T3, class MeshDomain, class MeshCriteria>
+void initialize_from_image(C3T3& c3t3, const MeshDomain& domain, const CGAL::Image_3& image, const MeshCriteria& criteria,
+                           bool protect_features, const std::string& src) {
+  CGAL::get_default_random() = CGAL::Random(0);  // its ray directions: one input, one mesh
+  std::ostringstream chatter;  // the initialisation reports its counts on std::cout
+  std::streambuf* const out = std::cout.rdbuf(chatter.rdbuf());
+  try {
+    ::initialize_triangulation_from_labeled_image(c3t3, domain, image, criteria, static_cast<unsigned char>(0),
+                                                protect_features);
+  } catch (...) {
+    std::cout.rdbuf(out);
+    throw;
+  }
+  std::cout.rdbuf(out);
+  if (c3t3.triangulation().dimension() != 3)
+    throw InputError(src + ": no surface points were found to start the mesh from (is the tissue thinner than a voxel?)");
 }
 
 }  // namespace
@@ -178,14 +203,12 @@ LabelledTetMesh mesh_label_volume(const LabelVolume& v, const LabelMeshOptions& 
   Criteria criteria(p::edge_size = opt.cell_size, p::facet_angle = opt.facet_angle, p::facet_size = opt.cell_size,
                     p::facet_distance = opt.facet_distance_ratio * opt.cell_size,
                     p::cell_radius_edge_ratio = opt.radius_edge_ratio, p::cell_size = opt.cell_size);
+  C3t3 c3t3;
+  initialize_from_image(c3t3, domain, image, criteria, opt.protect_features, src);
   // As in tetrahedralize(): optimisers without time limits, so that one input gives one mesh.
-  C3t3 c3t3 = opt.protect_features
-                  ? CGAL::make_mesh_3<C3t3>(domain, criteria, p::features(domain), p::no_lloyd(), p::no_odt(),
-                                            p::perturb(p::time_limit = 0.0, p::sliver_bound = 10.0),
-                                            p::exude(p::time_limit = 0.0, p::sliver_bound = 10.0))
-                  : CGAL::make_mesh_3<C3t3>(domain, criteria, p::no_features(), p::no_lloyd(), p::no_odt(),
-                                            p::perturb(p::time_limit = 0.0, p::sliver_bound = 10.0),
-                                            p::exude(p::time_limit = 0.0, p::sliver_bound = 10.0));
+  // Not reset: that would drop the weights of the protected lines' balls.
+  CGAL::refine_mesh_3(c3t3, domain, criteria, p::no_lloyd(), p::no_odt(), p::perturb(p::time_limit = 0.0, p::sliver_bound = 10.0),
+                      p::exude(p::time_limit = 0.0, p::sliver_bound = 10.0), p::no_reset_c3t3());
 
   // Image coordinates -> RAS.
   const Mat3 to_ras = v.ijk_to_ras * spacing.cwiseInverse().asDiagonal();
@@ -271,7 +294,9 @@ LabelledTetMesh mesh_label_volume(const LabelVolume& v, const LabelMeshOptions& 
       CGAL::Mesh_criteria_3<SubTr> sub_criteria(p::facet_angle = opt.facet_angle, p::facet_size = opt.tumour_facet_size,
                                                 p::facet_distance = 0.1 * opt.tumour_facet_size,
                                                 p::cell_radius_edge_ratio = opt.radius_edge_ratio);
-      SubC3t3 sc = CGAL::make_mesh_3<SubC3t3>(sub_domain, sub_criteria, p::no_lloyd(), p::no_odt(), p::no_perturb(), p::no_exude());
+      SubC3t3 sc;
+      initialize_from_image(sc, sub_domain, sub, sub_criteria, false, src);
+      CGAL::refine_mesh_3(sc, sub_domain, sub_criteria, p::no_lloyd(), p::no_odt(), p::no_perturb(), p::no_exude(), p::no_reset_c3t3());
       auto to_ras_sub = [&](const SubTr::Vertex_handle& h) {
         const auto& q = h->point().point();
         return Vec3(v.origin + v.ijk_to_ras * (Vec3(q.x(), q.y(), q.z()).cwiseQuotient(spacing) + first.cast<double>()));

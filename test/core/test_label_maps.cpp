@@ -187,6 +187,62 @@ TEST(LabelMesher, MeshesTissueAndTumourFixesTheMuscleInterfaceAndReturnsTheTumou
   for (int i : f.chest_wall) EXPECT_LT(f.mesh.V(i, 1), 0.0036);
 }
 
+// Two breasts side by side, as a bilateral MRI has them: the image's centre is in the air between
+// them. The right one's tumour is half a ring (tube 3 mm, ring 12 mm), whose own box's centre is
+// outside it. CGAL's make_mesh_3 starts from rays shot from a box's centre and never returned on
+// either (the phantom's label map, whose centre is in the air, hung the same way).
+TEST(LabelMesher, MeshesAMapWhoseCentreIsOutsideTheTissueAndATumourWhoseCentreIsOutsideIt) {
+  const LabelVolume one = synthetic_breast(0.002);
+  LabelVolume v = one;
+  v.nx = 2 * one.nx;
+  v.labels.assign(static_cast<size_t>(v.voxel_count()), 0);
+  const Vec3 ball(0.004, 0.015, -0.003), ring = ball + Vec3(one.nx * 0.002, 0, 0);
+  long ball_voxels = 0, ring_voxels = 0;
+  Vec3 ring_sum = Vec3::Zero();
+  for (int k = 0; k < v.nz; ++k)
+    for (int j = 0; j < v.ny; ++j)
+      for (int i = 0; i < v.nx; ++i) {
+        std::uint8_t l = one.at(i < one.nx ? i : i - one.nx, j, k);
+        const Vec3 d = v.centre(i, j, k) - ring;
+        if (i >= one.nx && l == 3) l = 1;
+        const double off_ring = std::hypot(std::hypot(d.x(), d.z()) - 0.012, d.y());
+        if (i >= one.nx && d.z() >= 0 && off_ring < 0.003) {
+          l = 3;
+          ++ring_voxels;
+          ring_sum += v.centre(i, j, k);
+        }
+        if (i < one.nx && l == 3) ++ball_voxels;
+        v.labels[static_cast<size_t>(v.index(i, j, k))] = l;
+      }
+  ASSERT_GT(ring_voxels, 100);
+  const Vec3 centre = v.centre(v.nx / 2, v.ny / 2, v.nz / 2);
+  ASSERT_EQ(v.at(v.nx / 2, v.ny / 2, v.nz / 2), 0) << "the image's centre (" << centre.transpose() << ") is not in the air";
+  LabelMeshOptions o;
+  o.tissue = {1};
+  o.tumour = {3};
+  o.muscle = 4;
+  o.cell_size = 0.007;
+  const LabelledTetMesh m = mesh_label_volume(v, o);
+  ASSERT_GT(m.mesh.T.rows(), 1000);
+  double left = 0, right = 0;  // each breast's volume, by the x of its tetrahedra's first vertex
+  for (Eigen::Index t = 0; t < m.mesh.T.rows(); ++t)
+    (m.mesh.V(m.mesh.T(t, 0), 0) < 0.045 ? left : right) += tet_signed_volume(m.mesh.V, m.mesh.T, t);
+  EXPECT_NEAR(left / right, 1.0, 0.02);
+  EXPECT_TRUE(m.chest_wall_from_muscle);
+  // The tumours, largest first: each closed, with the volume and centroid of its voxels.
+  ASSERT_EQ(m.tumours.size(), 2u);
+  const double voxel = std::pow(0.002, 3);
+  EXPECT_NEAR(enclosed_volume(m.tumours[0].surface) / (static_cast<double>(ball_voxels) * voxel), 1.0, 0.1);
+  EXPECT_LT((volume_centroid(m.tumours[0].surface) - ball).norm(), 0.0005);
+  EXPECT_NEAR(enclosed_volume(m.tumours[1].surface) / (static_cast<double>(ring_voxels) * voxel), 1.0, 0.15);
+  EXPECT_LT((volume_centroid(m.tumours[1].surface) - ring_sum / static_cast<double>(ring_voxels)).norm(), 0.001);
+  // One input, one mesh.
+  const LabelledTetMesh again = mesh_label_volume(v, o);
+  ASSERT_EQ(again.mesh.V.rows(), m.mesh.V.rows());
+  EXPECT_EQ((again.mesh.V - m.mesh.V).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((again.tumours[1].surface.V - m.tumours[1].surface.V).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(LabelMesher, RefusesEmptyTumoursMissingMusclesAnisotropicVoxelsAndUnknownLabels) {
   LabelVolume v = synthetic_breast(0.002);
   LabelMeshOptions o;
