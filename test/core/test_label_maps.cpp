@@ -57,6 +57,16 @@ LabelVolume synthetic_breast(double voxel = 0.001, double tumour_radius = 0.008)
   return v;
 }
 
+// The synthetic breast's labels: fat tissue, the tumour, the muscle; 7 mm cells.
+LabelMeshOptions synthetic_breast_options() {
+  LabelMeshOptions o;
+  o.tissue = {1};
+  o.tumour = {3};
+  o.muscle = 4;
+  o.cell_size = 0.007;
+  return o;
+}
+
 TEST(LabelVolumeIo, NiftiAndNrrdKeepTheGeometryTheLabelsAndTheSegmentNames) {
   const std::string dir = test::temp_dir();
   LabelVolume v;
@@ -140,11 +150,7 @@ TEST(LabelVolumeIo, FilesThatAreNoLabelMapSayWhatIsWrongAndWhatToDo) {
 
 TEST(LabelMesher, MeshesTissueAndTumourFixesTheMuscleInterfaceAndReturnsTheTumourSurface) {
   const LabelVolume v = synthetic_breast();
-  LabelMeshOptions o;
-  o.tissue = {1};
-  o.tumour = {3};
-  o.muscle = 4;
-  o.cell_size = 0.007;
+  const LabelMeshOptions o = synthetic_breast_options();
   const LabelledTetMesh m = mesh_label_volume(v, o);
   ASSERT_GT(m.mesh.T.rows(), 1000);
   std::map<int, long> count;
@@ -217,11 +223,7 @@ TEST(LabelMesher, MeshesAMapWhoseCentreIsOutsideTheTissueAndATumourWhoseCentreIs
   ASSERT_GT(ring_voxels, 100);
   const Vec3 centre = v.centre(v.nx / 2, v.ny / 2, v.nz / 2);
   ASSERT_EQ(v.at(v.nx / 2, v.ny / 2, v.nz / 2), 0) << "the image's centre (" << centre.transpose() << ") is not in the air";
-  LabelMeshOptions o;
-  o.tissue = {1};
-  o.tumour = {3};
-  o.muscle = 4;
-  o.cell_size = 0.007;
+  const LabelMeshOptions o = synthetic_breast_options();
   const LabelledTetMesh m = mesh_label_volume(v, o);
   ASSERT_GT(m.mesh.T.rows(), 1000);
   double left = 0, right = 0;  // each breast's volume, by the x of its tetrahedra's first vertex

@@ -12,6 +12,7 @@
 
 #include "breast_tumour_registration/geometry/label_volume.h"
 #include "breast_tumour_registration/io/label_scene.h"
+#include "breast_tumour_registration/io/scene.h"
 
 namespace btr {
 
@@ -40,5 +41,8 @@ struct LabelPhantomFiles {
 /// prone_landmarks.mrk.json, supine_landmarks.mrk.json, supine_surface.obj and
 /// tumour_<name>_prone.obj / _supine.obj, all in RAS. InputError for a scene it cannot rasterize.
 LabelPhantomFiles write_label_phantom(const std::string& scene_yaml, const std::string& dir, const LabelPhantomOptions& opt = {});
+/// The same for a loaded scene with its prone tetrahedra (e.g. a surface scene meshed by
+/// with_simulation_mesh, its prone_labels set): its chest wall must be the plane z = 0.
+LabelPhantomFiles write_label_phantom(const Scene& s, const std::string& dir, const LabelPhantomOptions& opt = {});
 
 }  // namespace btr
