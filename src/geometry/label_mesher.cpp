@@ -97,6 +97,14 @@ void clear_specks(const LabelVolume& v, const std::set<int>& labels, long min_vo
       });
 }
 
+// A zeroed image of bytes, nx x ny x nz voxels of `spacing`; `what` names it when memory runs out.
+CGAL::Image_3 byte_image(const Eigen::Vector3i& n, const Vec3& spacing, const std::string& what) {
+  _image* im = _createImage(n[0], n[1], n[2], 1, spacing[0], spacing[1], spacing[2], 1, WK_FIXED, SGN_UNSIGNED);
+  if (!im) throw InputError("out of memory for " + what);
+  std::fill_n(static_cast<unsigned char*>(im->data), static_cast<long>(n[0]) * n[1] * n[2], 0);
+  return CGAL::Image_3(im);
+}
+
 // One component's voxels as a binary image in a box around them (3 voxels of margin);
 // `first` receives the voxel index of the box's voxel (0, 0, 0).
 CGAL::Image_3 component_image(const LabelVolume& v, const std::vector<long>& voxels, const Vec3& spacing, Eigen::Vector3i& first) {
@@ -111,15 +119,13 @@ CGAL::Image_3 component_image(const LabelVolume& v, const std::vector<long>& vox
   const int margin = 3;
   first = lo - Eigen::Vector3i::Constant(margin);
   const Eigen::Vector3i n = hi - lo + Eigen::Vector3i::Constant(2 * margin + 1);
-  _image* im = _createImage(n[0], n[1], n[2], 1, spacing[0], spacing[1], spacing[2], 1, WK_FIXED, SGN_UNSIGNED);
-  if (!im) throw InputError("out of memory for a tumour image");
-  auto* data = static_cast<unsigned char*>(im->data);
-  std::fill(data, data + static_cast<long>(n[0]) * n[1] * n[2], 0);
+  CGAL::Image_3 image = byte_image(n, spacing, "a tumour image");
+  auto* data = static_cast<unsigned char*>(image.data());
   for (long m : voxels) {
     const Eigen::Vector3i q = ijk(m) - first;
     data[(static_cast<long>(q[2]) * n[1] + q[1]) * n[0] + q[0]] = 1;
   }
-  return CGAL::Image_3(im);
+  return image;
 }
 
 // The first surface points of a labelled image's mesh, from rays shot inside each connected
@@ -132,15 +138,11 @@ void initialize_from_image(C3T3& c3t3, const MeshDomain& domain, const CGAL::Ima
                            bool protect_features, const std::string& src) {
   CGAL::get_default_random() = CGAL::Random(0);  // its ray directions: one input, one mesh
   std::ostringstream chatter;  // the initialisation reports its counts on std::cout
-  std::streambuf* const out = std::cout.rdbuf(chatter.rdbuf());
-  try {
-    ::initialize_triangulation_from_labeled_image(c3t3, domain, seeds, criteria, static_cast<unsigned char>(0),
-                                                protect_features);
-  } catch (...) {
-    std::cout.rdbuf(out);
-    throw;
-  }
-  std::cout.rdbuf(out);
+  struct Restore {
+    std::streambuf* out;
+    ~Restore() { std::cout.rdbuf(out); }
+  } restore{std::cout.rdbuf(chatter.rdbuf())};
+  ::initialize_triangulation_from_labeled_image(c3t3, domain, seeds, criteria, static_cast<unsigned char>(0), protect_features);
   if (c3t3.triangulation().dimension() != 3)
     throw InputError(src + ": no surface points were found to start the mesh from (is the tissue thinner than a voxel?)");
 }
@@ -201,10 +203,9 @@ LabelledTetMesh mesh_label_volume(const LabelVolume& v, const LabelMeshOptions& 
 
   // The image Mesh_3 sees: tissue and tumour labels as they are, the muscle as itself (outside,
   // but its interface is told apart), everything else 0 (outside).
-  _image* im = _createImage(v.nx, v.ny, v.nz, 1, spacing[0], spacing[1], spacing[2], 1, WK_FIXED, SGN_UNSIGNED);
-  if (!im) throw InputError(src + ": out of memory for the meshing image");
-  CGAL::Image_3 image(im);
-  auto* data = static_cast<unsigned char*>(im->data);
+  const Eigen::Vector3i voxels(v.nx, v.ny, v.nz);
+  CGAL::Image_3 image = byte_image(voxels, spacing, src + "'s meshing image");
+  auto* data = static_cast<unsigned char*>(image.data());
   for (int k = 0; k < v.nz; ++k)
     for (int j = 0; j < v.ny; ++j)
       for (int i = 0; i < v.nx; ++i) {
@@ -234,10 +235,8 @@ LabelledTetMesh mesh_label_volume(const LabelVolume& v, const LabelMeshOptions& 
   // as a label map (a blocky gland) had twice the tetrahedra, one of them flat. Seeding from the
   // largest body of tissue alone misses the subdomains inside it (the tumours).
   const long min_voxels = std::max(1L, static_cast<long>(std::pow(0.5 * opt.cell_size, 3) / voxel_volume));
-  _image* seed_im = _createImage(v.nx, v.ny, v.nz, 1, spacing[0], spacing[1], spacing[2], 1, WK_FIXED, SGN_UNSIGNED);
-  if (!seed_im) throw InputError(src + ": out of memory for the meshing image");
-  CGAL::Image_3 seeds(seed_im);
-  auto* seed_data = static_cast<unsigned char*>(seed_im->data);
+  CGAL::Image_3 seeds = byte_image(voxels, spacing, src + "'s seed image");
+  auto* seed_data = static_cast<unsigned char*>(seeds.data());
   std::copy(data, data + v.voxel_count(), seed_data);
   clear_specks(v, meshed, min_voxels, seed_data);
   C3t3 c3t3;

@@ -27,9 +27,7 @@ SurfaceMesh to_ras(const SurfaceMesh& s) { return SurfaceMesh{to_ras(s.V), s.F};
 }  // namespace
 
 LabelPhantomFiles write_label_phantom(const std::string& scene_yaml, const std::string& dir, const LabelPhantomOptions& opt) {
-  const Scene s = load_scene(scene_yaml);
-  if (s.prone_source) throw InputError(scene_yaml + ": the label phantom needs the prone tetrahedral mesh (prone.tet_mesh)");
-  return write_label_phantom(s, dir, opt);
+  return write_label_phantom(load_scene(scene_yaml), dir, opt);
 }
 
 LabelPhantomFiles write_label_phantom(const Scene& s, const std::string& dir, const LabelPhantomOptions& opt) {
@@ -37,7 +35,8 @@ LabelPhantomFiles write_label_phantom(const Scene& s, const std::string& dir, co
   const std::string& scene_yaml = s.path;
   if (!(opt.muscle_thickness > 0) || !(opt.margin >= 0))
     throw InputError("label phantom: voxel size and muscle thickness must be positive, the margin >= 0");
-  if (s.prone.T.rows() == 0) throw InputError(scene_yaml + ": the label phantom needs a tetrahedral prone model");
+  if (s.prone.T.rows() == 0)
+    throw InputError(scene_yaml + ": the label phantom needs the prone tetrahedral mesh (prone.tet_mesh, or a meshed scene)");
   const Mat3 R = phantom_to_ras();
   TetMesh prone{to_ras(s.prone.V), s.prone.T};
   // The chest wall must be the plane y = 0 in RAS (z = 0 in the phantom): voxel centres lie
