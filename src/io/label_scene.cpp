@@ -152,6 +152,7 @@ LabelSceneSummary write_scene_from_labels(const std::string& dir, const LabelVol
   scene["patient_frame"] = "RAS";
   scene["frame"] = "RAS patient coordinates of the label map (+x right, +y anterior, +z superior)";
   scene["prone"]["tet_mesh"] = "prone.vtk";
+  scene["prone"]["cell_size_mm"] = opt.mesh.cell_size * 1e3;  // made at: a call at this size keeps it
   scene["chest_wall"] = "chest_wall.txt";
   YAML::Node tumours;
   std::vector<Vec3> truth_centroids;

@@ -97,6 +97,12 @@ Scene load_scene_fields(const std::string& path) {
   if (!prone || !prone.IsMap()) c.fail("prone", "missing; give prone.tet_mesh or prone.surface");
   SurfaceMesh prone_surface;
   bool have_surface = false;
+  // The size a prone surface is meshed at, or the size a prone tetrahedral mesh was made at.
+  std::optional<double> stated_cell;
+  if (prone["cell_size_mm"]) {
+    stated_cell = mm_to_m(c.number(prone["cell_size_mm"], "prone.cell_size_mm"));
+    if (!(*stated_cell > 0) || !std::isfinite(*stated_cell)) c.fail("prone.cell_size_mm", "must be positive");
+  }
   if (prone["surface"]) {
     prone_surface = c.load("prone.surface", [&] { return read_surface(c.path_of(prone["surface"], "prone.surface"), s.units); });
     check_length_scale(prone_surface.V, s.units, path, "prone.surface");
@@ -112,6 +118,7 @@ Scene load_scene_fields(const std::string& path) {
       return m;
     });
     check_length_scale(s.prone.V, s.units, path, "prone.tet_mesh");
+    s.prone_mesh_cell_size = stated_cell;
   } else if (have_surface) {
     // Meshed by mesh_prone (below, or by the caller at the size its preset simulates).
     c.load("prone.surface", [&] {
@@ -121,11 +128,7 @@ Scene load_scene_fields(const std::string& path) {
     });
     s.prone_source = ProneSurfaceSource{};
     s.prone_source->surface = prone_surface;
-    if (prone["cell_size_mm"]) {
-      const double cell = mm_to_m(c.number(prone["cell_size_mm"], "prone.cell_size_mm"));
-      if (!(cell > 0) || !std::isfinite(cell)) c.fail("prone.cell_size_mm", "must be positive");
-      s.prone_source->cell_size = cell;
-    }
+    s.prone_source->cell_size = stated_cell;
   } else {
     c.fail("prone", "give prone.tet_mesh or prone.surface");
   }
@@ -135,7 +138,6 @@ Scene load_scene_fields(const std::string& path) {
     s.tumour_cell_size = cell;
   }
   if (prone["cell_labels"] && !prone["tet_mesh"]) c.fail("prone.cell_labels", "only with prone.tet_mesh (the file holding them)");
-  if (prone["cell_size_mm"] && !have_surface) c.fail("prone.cell_size_mm", "only with prone.surface (the size it is tetrahedralized at)");
 
   // Chest wall: tet vertex indices, or surface indices re-attached after tetrahedralization.
   if (!root["chest_wall"]) c.fail("chest_wall", "missing: the fixed chest-wall vertices are required");

@@ -51,7 +51,11 @@ Scene with_simulation_mesh(const Scene& scene, double cell_size, double tumour_c
   for (size_t i = 0; i < scene.landmark_anchors.size(); ++i)
     landmarks.row(static_cast<Eigen::Index>(i)) = scene.landmark_anchors[i].position(scene.prone.V).transpose();
   if (landmarks.rows()) out.landmark_anchors = attach_to_boundary(out.prone, landmarks).anchors;
-  if (!scene.prone_labels.empty()) out.prone_labels = transfer_cell_labels(scene.prone, scene.prone_labels, out.prone);
+  if (!scene.prone_labels.empty()) {
+    TransferredLabels labels = transfer_cell_labels(scene.prone, scene.prone_labels, out.prone);
+    out.prone_labels = std::move(labels.labels);
+    out.prone_label_remnants = std::move(labels.remnants);
+  }
   out.tetrahedralized = true;
   out.tetrahedralize_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;

@@ -18,6 +18,8 @@
 #include "breast_tumour_registration/io/markups_io.h"
 #include "breast_tumour_registration/io/mesh_io.h"
 #include "breast_tumour_registration/registration/registration_engine.h"
+#include "breast_tumour_registration/registration/registration_pipeline.h"
+#include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 #include "breast_tumour_registration/simulation/label_phantom.h"
 #include "test_util.h"
@@ -407,6 +409,75 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
   const TetMeshFile vtk = read_tet_mesh_file(dir + "/out/slicer/registered.vtk", LengthUnit::Millimetre);
   EXPECT_EQ(cell_labels(vtk, "label", "registered.vtk").size(), static_cast<size_t>(vtk.mesh.T.rows()));
   EXPECT_TRUE(std::filesystem::exists(dir + "/out/slicer/tumour_" + r.tumours[0].name + ".ply"));
+}
+
+// A label mesh's refinement along its tissue interfaces shortens its edges, so by its mean edge
+// it reads as finer than the size it was made at, and the engine re-meshed it from its boundary
+// (SfePy's bodies as label maps: ended 0.08 to 0.56 mm farther, BENCHMARKS.md, "A label scene
+// keeps its mesh"). The scene states the size; a call at that size keeps the mesh.
+TEST(LabelMapRoundTrip, ALabelSceneStatesItsCellSizeAndACallAtThatSizeKeepsItsMesh) {
+  const std::string dir = test::temp_dir();
+  LabelVolume v = synthetic_breast();
+  // A gland (label 2): a flattened ellipsoid of the fat over the tumour.
+  for (int k = 0; k < v.nz; ++k)
+    for (int j = 0; j < v.ny; ++j)
+      for (int i = 0; i < v.nx; ++i) {
+        const Vec3 p = v.centre(i, j, k);
+        auto& l = v.labels[static_cast<size_t>(v.index(i, j, k))];
+        if (l == 1 && std::pow(p.x() / 0.028, 2) + std::pow((p.y() - 0.014) / 0.008, 2) + std::pow(p.z() / 0.028, 2) < 1) l = 2;
+      }
+  LabelTable table;
+  table.gland_stiffness = 2;
+  table.tumour_stiffness = 5;
+  const RegistrationOptions balanced = preset_options("balanced");
+  LabelSceneOptions o;
+  o.mesh.source = "synthetic breast";
+  o.mesh.cell_size = balanced.nodal_simulation_cell_size;  // the size btr_scene_from_labels meshes a prone image at
+  write_scene_from_labels(dir, v, table, o);
+  const Scene s = load_scene(dir + "/scene.yaml");
+  ASSERT_TRUE(s.prone_mesh_cell_size.has_value());
+  EXPECT_NEAR(*s.prone_mesh_cell_size, o.mesh.cell_size, 1e-12);
+  RegistrationOptions at_own = balanced;
+  at_own.simulation_cell_size = simulation_cell_size_for(s, balanced);
+  ASSERT_EQ(at_own.simulation_cell_size, o.mesh.cell_size);
+  // By its edges it reads as finer (the gland's and the tumour's interfaces) ...
+  const double edge = mean_edge_length_away_from_tumours(s, at_own.simulation_cell_size, 0);
+  std::printf("label mesh at %.1f mm: mean edge %.2f mm, %ld tetrahedra\n", o.mesh.cell_size * 1e3, edge * 1e3,
+              static_cast<long>(s.prone.T.rows()));
+  Scene unstated = s;
+  unstated.prone_mesh_cell_size.reset();
+  EXPECT_TRUE(needs_simulation_mesh(unstated, at_own));
+  // ... but it states its size: kept at that size and anything finer, re-meshed clearly coarser.
+  EXPECT_FALSE(needs_simulation_mesh(s, at_own));
+  RegistrationOptions finer = balanced;
+  finer.simulation_cell_size = 0.5 * o.mesh.cell_size;
+  EXPECT_FALSE(needs_simulation_mesh(s, finer));
+  RegistrationOptions coarser = balanced;
+  coarser.simulation_cell_size = coarser.nodal_simulation_cell_size = 1.5 * o.mesh.cell_size;
+  EXPECT_TRUE(needs_simulation_mesh(s, coarser));
+  RegistrationEngine engine(s);
+  const PreparedScene& kept = engine.prepare(balanced);
+  EXPECT_TRUE(kept.mesh_note.empty()) << kept.mesh_note;
+  EXPECT_EQ(kept.model.rest.T.rows(), s.prone.T.rows());
+  // Re-meshed at 13.5 mm, no centroid falls in the 16 mm tumour's tetrahedra: the tetrahedron
+  // holding it takes its share (before, the call refused the scene it had just re-meshed).
+  const PreparedScene& coarse = engine.prepare(coarser);
+  EXPECT_NE(coarse.mesh_note.find("re-tetrahedralized the prone model"), std::string::npos);
+  ASSERT_EQ(coarse.scene.prone_label_remnants.size(), 1u);
+  EXPECT_EQ(coarse.scene.prone_label_remnants[0].label, 3);
+  EXPECT_NEAR(coarse.scene.prone_label_remnants[0].volume, 4.0 / 3 * M_PI * std::pow(0.008, 3), 0.3 * 4.0 / 3 * M_PI * std::pow(0.008, 3));
+  EXPECT_LT((coarse.scene.prone_label_remnants[0].centroid - Vec3(0.004, 0.015, -0.003)).norm(), 0.002);
+  EXPECT_EQ(std::count(coarse.model.material_names.begin(), coarse.model.material_names.end(), "tumour (partial volume)"), 1);
+  EXPECT_TRUE(std::any_of(coarse.warnings.begin(), coarse.warnings.end(), [](const std::string& w) {
+    return w.find("regions 'tumour': the re-meshed model's cells are coarser") != std::string::npos;
+  })) << ::testing::PrintToString(coarse.warnings);
+  // A stated size that is no size is named.
+  std::string text = test::scene_text(dir);
+  const size_t at = text.find("cell_size_mm: ");  // prone's, the first
+  ASSERT_NE(at, std::string::npos);
+  test::write_text(dir + "/bad.yaml", text.replace(at, text.find('\n', at) - at, "cell_size_mm: 0"));
+  EXPECT_NE(message_of([&] { load_scene(dir + "/bad.yaml"); }).find("field 'prone.cell_size_mm': must be positive"),
+            std::string::npos);
 }
 
 TEST(LabelMapRoundTrip, ScenesTakeSlicerPointListsAndNameAFiducialOffTheSkinAsAFrameMistake) {

@@ -19,6 +19,15 @@ struct MaterialRegion {
   std::optional<SurfaceMesh> surface;  ///< ... or those whose centroid lies inside this closed surface (model frame)
 };
 
+/// A cell label that a mesh of the body carries on no tetrahedron (after transfer_cell_labels:
+/// the labelled region is smaller than the new cells): where it was and how much of it, so the
+/// tetrahedron holding it can take its share (assign_material_regions).
+struct LabelRemnant {
+  int label = 0;
+  Vec3 centroid = Vec3::Zero();  ///< volume centroid of the labelled tetrahedra [m]
+  double volume = 0;             ///< their volume [m^3]
+};
+
 /// InputError (naming `where`) unless the region has a name, a finite positive Young's
 /// modulus and exactly one of label and surface (a valid closed surface).
 void validate_material_region(const MaterialRegion& region, const std::string& where);

@@ -4,7 +4,8 @@
 //   units: mm                      # m or mm (required)
 //   prone:
 //     tet_mesh: prone.vtk          # or `surface: prone.obj` to tetrahedralize (cell_size_mm)
-//     cell_size_mm: 6
+//     cell_size_mm: 6              # with surface: the size it is meshed at; with tet_mesh: the size
+//                                  # it was made at (a call re-meshes it only for clearly coarser cells)
 //     tumour_cell_size_mm: 4       # optional: where a call meshes the prone model, finer cells
 //                                  # around each tumour (0: none; default: the preset's)
 //   chest_wall: chest_wall.txt     # vertex indices of prone.tet_mesh (or of prone.surface)
@@ -75,6 +76,10 @@ struct Scene {
   std::string path;
   LengthUnit units = LengthUnit::Millimetre;
   TetMesh prone;                         ///< model frame (empty for a prone surface until mesh_prone)
+  /// `prone.cell_size_mm` with `prone.tet_mesh` [m]: the cell size the tetrahedral mesh was made
+  /// at (btr_scene_from_labels states it). Where given, needs_simulation_mesh compares it with a
+  /// call's size instead of reading the mesh's edges, which a label mesh's interfaces shorten.
+  std::optional<double> prone_mesh_cell_size;
   std::optional<ProneSurfaceSource> prone_source;  ///< the prone model was given as a surface
   bool tetrahedralized = false;          ///< prone was meshed from prone_source
   double tetrahedralize_seconds = 0;
@@ -108,6 +113,9 @@ struct Scene {
   bool nodal_fallback = true;
   std::vector<MaterialRegion> regions;   ///< per-element materials, in order (later wins)
   std::vector<int> prone_labels;         ///< cell label per prone tetrahedron, when a region selects by label
+  /// Labels a re-mesh (with_simulation_mesh) left on no tetrahedron of `prone`: their share goes
+  /// to the tetrahedron holding them (assign_material_regions)
+  std::vector<LabelRemnant> prone_label_remnants;
   std::optional<double> tumour_youngs_modulus;
   /// `youngs_modulus: estimate`: the range [Pa] the stiffness step searches (material.youngs_modulus
   /// is then only the reference the other materials are given relative to).
