@@ -2,8 +2,9 @@
 // across each boundary edge (within the chest wall, across its rim, on the skin), and the
 // re-mesh's vertices on the chest wall at CGAL feature angles (tetrahedralize's feature_angle;
 // 60 deg is the package's). A label mesh's chest wall (the muscle interface) is bumpy, and its
-// sharp edges become protected features of the re-mesh.
-// Usage: remesh_chest_wall_features SCENE.yaml CELL_MM ANGLE_DEG...
+// sharp edges become protected features of the re-mesh. A face is the chest wall's where its
+// three vertices are.
+// Usage: remesh_chest_wall_features SCENE.yaml CELL_MM [ANGLE_DEG...]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -18,8 +19,8 @@
 using namespace btr;
 
 int main(int argc, char** argv) {
-  if (argc < 4) {
-    std::fprintf(stderr, "usage: %s SCENE.yaml CELL_MM ANGLE_DEG...\n", argv[0]);
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: %s SCENE.yaml CELL_MM [ANGLE_DEG...]\n", argv[0]);
     return 2;
   }
   const Scene s = load_scene(argv[1]);
@@ -39,12 +40,14 @@ int main(int argc, char** argv) {
       faces_of_edge[{std::min(i, j), std::max(i, j)}].push_back(f);
     }
   }
-  const char* kind[3] = {"within the chest wall", "across its rim", "on the skin"};
+  const char* kind[3] = {"between two wall faces", "a wall and a skin face", "between two skin faces"};
   int hist[3][7] = {};
   for (const auto& [e, fs] : faces_of_edge) {
     if (fs.size() != 2) continue;
     const double angle = std::acos(std::clamp(normal[fs[0]].dot(normal[fs[1]]), -1.0, 1.0)) * 180 / M_PI;
-    const int k = on_wall[e.first] && on_wall[e.second] ? 0 : (on_wall[e.first] || on_wall[e.second] ? 1 : 2);
+    auto wall_face = [&](int f) { return on_wall[S.F(f, 0)] && on_wall[S.F(f, 1)] && on_wall[S.F(f, 2)]; };
+    const int walls = wall_face(fs[0]) + wall_face(fs[1]);
+    const int k = walls == 2 ? 0 : walls == 1 ? 1 : 2;
     ++hist[k][std::min(6, static_cast<int>(angle / 20))];
   }
   std::printf("%ld boundary vertices, %zu on the chest wall; edges by normal angle 0-20-40-60-80-100-120-180 deg:\n",
