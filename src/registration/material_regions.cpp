@@ -56,7 +56,8 @@ std::vector<std::string> assign_material_regions(RegistrationModel& model, const
       for (Eigen::Index t = 0; t < nt; ++t)
         if (labels[t] == *r.label) members.push_back(static_cast<int>(t));
       if (members.empty()) {
-        const auto remnant = std::find_if(remnants.begin(), remnants.end(), [&](const LabelRemnant& x) { return x.label == *r.label; });
+        const auto remnant =
+            std::find_if(remnants.begin(), remnants.end(), [&](const LabelRemnant& x) { return x.label == *r.label; });
         if (remnant == remnants.end())
           throw InputError("regions '" + r.name + "': no tetrahedron carries label " + std::to_string(*r.label));
         notes.push_back(mix_into_holding_tetrahedron(

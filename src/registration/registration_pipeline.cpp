@@ -215,7 +215,7 @@ bool needs_simulation_mesh(const Scene& scene, const RegistrationOptions& opt) {
   // tumours (a mesh made with prone.tumour_cell_size_mm is finer there by design). A mesh that
   // states the size it was made at is judged by it: a label mesh's refinement along its tissue
   // interfaces reads as a finer mesh (SfePy's bodies as label maps at 9 mm: mean edge 6.5 mm),
-  // and its re-mesh ended farther on all four (BENCHMARKS.md, "A label scene keeps its mesh").
+  // and its re-mesh ended farther in all 12 preset calls (BENCHMARKS.md, "A label scene keeps its mesh").
   constexpr double kEdgePerCell = 1.35, kClearlyFiner = 1.1;
   if (scene.prone_mesh_cell_size) return kEdgePerCell * *scene.prone_mesh_cell_size < kClearlyFiner * opt.simulation_cell_size;
   return mean_edge_length_away_from_tumours(scene, opt.simulation_cell_size, tumour_cell_size_for(scene, opt)) <
@@ -238,7 +238,8 @@ RegistrationModel prepare_model(const Scene& scene, std::vector<std::string>& wa
                          std::to_string(m.tumours.back().embedding.max_outside_distance * 1e3) +
                          " mm); they follow the nearest tetrahedron");
   }
-  for (std::string& note : assign_material_regions(m, scene.regions, scene.prone_labels, scene.prone_label_remnants)) warnings.push_back(std::move(note));
+  for (std::string& note : assign_material_regions(m, scene.regions, scene.prone_labels, scene.prone_label_remnants))
+    warnings.push_back(std::move(note));
   if (scene.tumour_youngs_modulus) {
     stiffen_tumours(m, *scene.tumour_youngs_modulus);
     if (m.stiff_tetrahedra == 0)

@@ -413,7 +413,7 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
 
 // A label mesh's refinement along its tissue interfaces shortens its edges, so by its mean edge
 // it reads as finer than the size it was made at, and the engine re-meshed it from its boundary
-// (SfePy's bodies as label maps: ended 0.08 to 0.56 mm farther, BENCHMARKS.md, "A label scene
+// (SfePy's bodies as label maps: ended 0.08 to 0.99 mm farther, BENCHMARKS.md, "A label scene
 // keeps its mesh"). The scene states the size; a call at that size keeps the mesh.
 TEST(LabelMapRoundTrip, ALabelSceneStatesItsCellSizeAndACallAtThatSizeKeepsItsMesh) {
   const std::string dir = test::temp_dir();
