@@ -67,7 +67,9 @@ LabelPhantomFiles write_label_phantom(const Scene& s, const std::string& dir, co
   const int first_tissue = n_back + n_muscle;  // the first voxel layer anterior of the chest wall
   const int j_end = std::min(v.ny, first_tissue + by_front);
 
-  // Tissue: voxel centres inside the prone mesh take the label of their tetrahedron.
+  // Tissue: voxel centres inside the prone mesh take the label of their tetrahedron; a tumour's
+  // tetrahedra (a heterogeneous phantom's stiff ones, the whole of any that reaches its sphere)
+  // are fat here, and the tumours are their surfaces (below), as a segmentation gives them.
   std::vector<long> ids;
   std::vector<Vec3> centres;
   for (int k = pad_z; k < std::min(v.nz, pad_z + bz); ++k)
@@ -84,7 +86,8 @@ LabelPhantomFiles write_label_phantom(const Scene& s, const std::string& dir, co
   for (size_t r = 0; r < centres.size(); ++r) {
     if (outside[r]) continue;
     const int t = e.tet[static_cast<Eigen::Index>(r)];
-    v.labels[static_cast<size_t>(ids[r])] = static_cast<std::uint8_t>(s.prone_labels.empty() ? opt.fat : s.prone_labels[t]);
+    const int label = s.prone_labels.empty() ? opt.fat : s.prone_labels[t];
+    v.labels[static_cast<size_t>(ids[r])] = static_cast<std::uint8_t>(label == opt.tumour ? opt.fat : label);
   }
   // Tumours: voxel centres inside a prone tumour surface.
   for (const auto& t : s.tumours) {

@@ -22,6 +22,7 @@
 #include "breast_tumour_registration/registration/simulation_mesh.h"
 #include "breast_tumour_registration/simulation/registration_report.h"
 #include "breast_tumour_registration/simulation/label_phantom.h"
+#include "breast_tumour_registration/simulation/phantom_scene.h"
 #include "test_util.h"
 
 namespace btr {
@@ -409,6 +410,33 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
   const TetMeshFile vtk = read_tet_mesh_file(dir + "/out/slicer/registered.vtk", LengthUnit::Millimetre);
   EXPECT_EQ(cell_labels(vtk, "label", "registered.vtk").size(), static_cast<size_t>(vtk.mesh.T.rows()));
   EXPECT_TRUE(std::filesystem::exists(dir + "/out/slicer/tumour_" + r.tumours[0].name + ".ply"));
+}
+
+// A heterogeneous phantom's stiff tumour tetrahedra are every one whose centroid lies in a
+// sphere, a blocky shell beyond it; in its label map the tumours are the spheres (15 tumour
+// components had come out of the 8 mm phantom's map, 5 of them the tracked tumours).
+TEST(LabelMapRoundTrip, AHeterogeneousPhantomsTumoursAreItsTumourSurfacesNotItsTumourTetrahedra) {
+  const std::string dir = test::temp_dir();
+  PhantomSceneOptions po;
+  po.phantom.tet.cell_size = 0.012;
+  po.phantom.surface_rings = 12;
+  po.youngs_modulus = 1000;
+  po.gland_youngs_modulus = 2000;
+  po.tumour_youngs_modulus = 10000;
+  write_phantom_scene(dir + "/phantom", po);
+  const Scene s = load_meshed_scene(dir + "/phantom/scene.yaml");
+  ASSERT_FALSE(s.prone_labels.empty());
+  const LabelPhantomFiles f = write_label_phantom(s, dir + "/labels");
+  const LabelVolume v = read_label_volume(f.label_map);
+  std::map<int, long> count;
+  for (auto l : v.labels) ++count[l];
+  double tumour_volume = 0;
+  for (const auto& t : s.tumours) tumour_volume += std::abs(enclosed_volume(t.prone));
+  const double voxel = std::abs(v.ijk_to_ras.determinant());
+  std::printf("tumour voxels %ld (%.0f mm^3), the spheres %.0f mm^3; gland voxels %ld\n", count[3], count[3] * voxel * 1e9,
+              tumour_volume * 1e9, count[2]);
+  EXPECT_NEAR(count[3] * voxel, tumour_volume, 0.05 * tumour_volume);
+  EXPECT_GT(count[2], 0);
 }
 
 // A label mesh's refinement along its tissue interfaces shortens its edges, so by its mean edge
