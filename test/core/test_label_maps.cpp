@@ -417,10 +417,7 @@ TEST(LabelMapRoundTrip, ThePhantomFromItsLabelMapRegistersAsThePhantomWithin01mm
 // components had come out of the 8 mm phantom's map, 5 of them the tracked tumours).
 TEST(LabelMapRoundTrip, AHeterogeneousPhantomsTumoursAreItsTumourSurfacesNotItsTumourTetrahedra) {
   const std::string dir = test::temp_dir();
-  PhantomSceneOptions po;
-  po.phantom.tet.cell_size = 0.012;
-  po.phantom.surface_rings = 12;
-  po.youngs_modulus = 1000;
+  PhantomSceneOptions po = test::coarse_phantom_options(1000);
   po.gland_youngs_modulus = 2000;
   po.tumour_youngs_modulus = 10000;
   write_phantom_scene(dir + "/phantom", po);

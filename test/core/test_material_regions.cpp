@@ -29,9 +29,7 @@ const std::string& labelled_phantom_dir() {
   static const std::string dir = [] {
     const std::string d = (std::filesystem::temp_directory_path() / "btr_tests" / "phantom_labelled").string();
     std::filesystem::remove_all(d);
-    PhantomSceneOptions o;
-    o.phantom.tet.cell_size = 0.012;
-    o.phantom.surface_rings = 12;
+    PhantomSceneOptions o = test::coarse_phantom_options(PhantomSceneOptions{}.youngs_modulus);
     o.gland_youngs_modulus = 6800;
     o.tumour_youngs_modulus = 20400;
     write_phantom_scene(d, o);

@@ -160,13 +160,9 @@ TEST(Phantom, AQuadraticTruthWhoseCornersInvertIsWrittenAsItsSkin) {
   // between their corners do not (a prone.vtk no reader accepts). The scene then gives the prone
   // model as its skin, tetrahedralized by the method, with the chest wall and landmarks
   // numbered on that skin and the regions as the closed surfaces the labels were made from.
-  PhantomSceneOptions o;
-  o.phantom.tet.cell_size = 0.012;
-  o.phantom.surface_rings = 12;
-  o.youngs_modulus = 350;
+  PhantomSceneOptions o = btr::test::coarse_phantom_options(350, ElementOrder::Quadratic);
   o.gland_youngs_modulus = 700;
   o.tumour_youngs_modulus = 3500;
-  o.element_order = ElementOrder::Quadratic;
   const std::string d = btr::test::temp_dir();
   const PhantomSceneSummary sum = write_phantom_scene(d, o);
   ASSERT_TRUE(sum.prone_written_as_surface);

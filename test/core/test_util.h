@@ -28,18 +28,22 @@ inline std::string temp_dir() {
   return dir.string();
 }
 
-/// A coarse phantom scene (12 mm cells, 12 surface rings, 2.2k tetrahedra) whose truth our FEM
-/// made at `youngs_modulus` [Pa] with `truth_elements` (linear: the method's own kind), written
-/// afresh into folder `d`; returns d.
-inline std::string write_coarse_phantom_in(const std::string& d, double youngs_modulus,
-                                           ElementOrder truth_elements = ElementOrder::Linear) {
-  std::filesystem::remove_all(d);
+/// The coarse phantom's options (12 mm cells, 12 surface rings, 2.2k tetrahedra), its truth made
+/// by our FEM at `youngs_modulus` [Pa] with `truth_elements` (linear: the method's own kind).
+inline PhantomSceneOptions coarse_phantom_options(double youngs_modulus, ElementOrder truth_elements = ElementOrder::Linear) {
   PhantomSceneOptions o;
   o.phantom.tet.cell_size = 0.012;
   o.phantom.surface_rings = 12;
   o.youngs_modulus = youngs_modulus;
   o.element_order = truth_elements;
-  write_phantom_scene(d, o);
+  return o;
+}
+
+/// A coarse phantom scene (coarse_phantom_options) written afresh into folder `d`; returns d.
+inline std::string write_coarse_phantom_in(const std::string& d, double youngs_modulus,
+                                           ElementOrder truth_elements = ElementOrder::Linear) {
+  std::filesystem::remove_all(d);
+  write_phantom_scene(d, coarse_phantom_options(youngs_modulus, truth_elements));
   return d;
 }
 /// The same in the temporary folder btr_tests/`name`.
