@@ -68,8 +68,8 @@ LabelPhantomFiles write_label_phantom(const Scene& s, const std::string& dir, co
   const int j_end = std::min(v.ny, first_tissue + by_front);
 
   // Tissue: voxel centres inside the prone mesh take the label of their tetrahedron; a tumour's
-  // tetrahedra (a heterogeneous phantom's stiff ones, the whole of any that reaches its sphere)
-  // are fat here, and the tumours are their surfaces (below), as a segmentation gives them.
+  // tetrahedra (a heterogeneous phantom's stiff ones: every one whose centroid lies in a
+  // sphere) are fat here, and the tumours are their surfaces (below), as a segmentation gives them.
   std::vector<long> ids;
   std::vector<Vec3> centres;
   for (int k = pad_z; k < std::min(v.nz, pad_z + bz); ++k)
